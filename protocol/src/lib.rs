@@ -1,0 +1,81 @@
+//! Frames and streaming parsers for the chassis motor-controller board's UART protocol.
+//!
+//! `no_std`, no allocation, no `unsafe`, no panic on any input. The same crate runs on the
+//! microcontroller that drives the chassis, on a Linux host behind a USB-UART adapter, in the
+//! board simulator and under the fuzzer.
+//!
+//! ```
+//! use chassis_protocol::{DownlinkParser, Imu, Telemetry, Turn, Velocity};
+//!
+//! // Master → board: fixed-size frames, built without a parser.
+//! let drive: [u8; 10] = Velocity::new(0, 300, 0).encode();
+//! assert_eq!(drive, [0xFF, 0xFE, 0x01, 0x00, 0x00, 0x01, 0x2C, 0x00, 0x00, 0x00]);
+//! let turn: [u8; 10] = Turn::by_deci_degrees(900).encode(); // once: the board adds it up
+//! assert_eq!(turn[9], 0b0001_0000);
+//!
+//! // Board → master: a byte stream in, typed frames out.
+//! let mut parser = DownlinkParser::new();
+//! let mut wire = Vec::new();
+//! for seq in 0..3 {
+//!     wire.extend_from_slice(&Imu { accel: [0, 0, 16_384], gyro: [0, 0, -6], seq }.encode());
+//! }
+//! let frames: Vec<Telemetry> = parser.frames(&wire).collect();
+//! assert_eq!(frames.len(), 3);
+//! assert!(matches!(frames[2], Telemetry::Imu(Imu { seq: 2, .. })));
+//! ```
+//!
+//! # Map
+//!
+//! | module | what |
+//! |---|---|
+//! | [`command`] | master → board: [`Velocity`], [`Turn`], [`Motors`], [`Setting`] ([`Action`], [`Write`], [`Register`] reads), [`SystemMode`] |
+//! | [`telemetry`] | board → master: [`Imu`], [`Encoders`], [`Battery`], [`Reply`] |
+//! | [`parse`] | [`DownlinkParser`] (board → master), [`UplinkParser`] (master → board), their counters |
+//!
+//! Each frame type has `LEN`, `encode() -> [u8; LEN]` and `decode(&[u8]) -> Result<_, Error>`;
+//! every decoded frame encodes back to the same bytes (reserved bits and unknown codes are kept).
+//! Signed values are signed in the API; magnitudes and direction bits exist only on the wire.
+//! Units are in the names (`centivolts`, `deci_degrees`, `centi_percent`).
+//!
+//! # The spec, and where it is ambiguous
+//!
+//! The protocol is the vendor's (Traditional Chinese) document, restated in `PROTOCOL.md`. Its
+//! ambiguities and the decisions taken are noted where they apply: A1 on [`DriveType`], A2 and A3
+//! in [`command::motion`], A5 in [`telemetry::encoders`], A7 in [`parse::downlink`].
+//!
+//! # Features
+//!
+//! * `defmt`: `defmt::Format` for every public type.
+//! * `serde`: `Serialize` / `Deserialize` for the typed frames and counters.
+//! * `std`: links `std` (nothing needs it yet).
+
+#![cfg_attr(not(any(test, feature = "std")), no_std)]
+#![forbid(unsafe_code)]
+#![cfg_attr(
+    not(test),
+    warn(
+        clippy::indexing_slicing,
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::arithmetic_side_effects,
+        clippy::unreachable,
+        clippy::todo
+    )
+)]
+
+mod bytes;
+pub mod command;
+mod error;
+pub mod parse;
+pub mod telemetry;
+mod wire;
+
+pub use bytes::FrameBytes;
+pub use command::{
+    Action, Command, CommandBytes, DriveType, MotorLoop, Motors, Register, Setting, SystemMode,
+    Turn, Velocity, VelocityReading, Write,
+};
+pub use error::Error;
+pub use parse::{DownlinkParser, DownlinkStats, Lock, UplinkParser, UplinkStats};
+pub use telemetry::{Battery, Encoders, Imu, Kind, Reply, Stream, Telemetry, TelemetryBytes};

@@ -1,0 +1,20 @@
+//! Streaming parsers, one per direction, and their counters.
+//!
+//! | parser | direction | emits | state |
+//! |---|---|---|---|
+//! | [`DownlinkParser`] | board → master | [`Telemetry`](crate::Telemetry) | 26 bytes |
+//! | [`UplinkParser`] | master → board | [`Command`](crate::Command) | 13 bytes |
+//!
+//! Both are `const fn new()`, take bytes one at a time ([`push`](DownlinkParser::push)) or a
+//! slice at a time ([`push_slice`](DownlinkParser::push_slice), which returns the bytes not yet
+//! consumed so none is ever dropped between calls), never allocate and never panic. Neither
+//! knows about time: a caller that can tell when the line goes quiet says so with `idle()`.
+
+pub mod downlink;
+pub mod stats;
+pub mod uplink;
+mod window;
+
+pub use downlink::{DownlinkParser, Frames, Lock};
+pub use stats::{DownlinkStats, UplinkStats};
+pub use uplink::{UplinkFrames, UplinkParser};

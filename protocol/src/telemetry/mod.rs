@@ -1,0 +1,270 @@
+//! Board → master frames ("downlink"): three telemetry streams sent unprompted, and replies.
+//!
+//! | header | frame | length | rate | module |
+//! |---|---|---|---|---|
+//! | `FF FA` | [`Imu`] | 15 | 100 Hz | [`imu`] |
+//! | `FF FB` | [`Encoders`] | 11 | 25 Hz | [`encoders`] |
+//! | `FF FC` | [`Battery`] | 7 | 1 Hz | [`battery`] |
+//! | `23` + code | [`Reply`] | 6 | once per read | [`reply`] |
+//!
+//! Each telemetry frame ends in a rolling count byte, one counter per [`Stream`].
+
+pub mod battery;
+pub mod encoders;
+pub mod imu;
+pub mod reply;
+
+pub use battery::Battery;
+pub use encoders::Encoders;
+pub use imu::Imu;
+pub use reply::Reply;
+
+use crate::bytes::FrameBytes;
+use crate::command::Register;
+use crate::error::Error;
+
+/// The longest board → master frame ([`Imu`]).
+pub const MAX_LEN: usize = Imu::LEN;
+
+/// The encoded bytes of a [`Telemetry`] frame.
+pub type TelemetryBytes = FrameBytes<MAX_LEN>;
+
+/// Checks the length and two-byte header of a telemetry frame.
+fn check_frame(bytes: &[u8], header: &[u8; 2], len: usize) -> Result<(), Error> {
+    if bytes.len() != len {
+        return Err(Error::Length);
+    }
+    if bytes.get(..2) != Some(&header[..]) {
+        return Err(Error::Header);
+    }
+    Ok(())
+}
+
+/// One of the three telemetry streams, each with its own rolling count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Stream {
+    /// `FF FA`, 100 Hz.
+    Imu,
+    /// `FF FB`, 25 Hz.
+    Encoders,
+    /// `FF FC`, 1 Hz.
+    Battery,
+}
+
+impl Stream {
+    /// The three streams, in header order; `Stream::ALL[s.index()] == s`.
+    pub const ALL: [Stream; 3] = [Stream::Imu, Stream::Encoders, Stream::Battery];
+
+    /// 0, 1, 2 for IMU, encoders, battery: an index for per-stream arrays.
+    #[must_use]
+    pub const fn index(self) -> usize {
+        match self {
+            Stream::Imu => 0,
+            Stream::Encoders => 1,
+            Stream::Battery => 2,
+        }
+    }
+
+    /// The nominal rate in hertz.
+    #[must_use]
+    pub const fn rate_hz(self) -> u16 {
+        match self {
+            Stream::Imu => 100,
+            Stream::Encoders => 25,
+            Stream::Battery => 1,
+        }
+    }
+}
+
+/// The kind of a board → master frame, as its header tells it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Kind {
+    /// A telemetry frame of this stream.
+    Telemetry(Stream),
+    /// A `#` reply.
+    Reply,
+}
+
+impl Kind {
+    /// The kind whose header is `first`, `second`. Replies count only with a reply code the
+    /// spec defines ([`Register::from_reply_code`]), which is what a streaming parser wants:
+    /// `23` is an ordinary byte in payloads.
+    #[must_use]
+    pub const fn from_header(first: u8, second: u8) -> Option<Kind> {
+        match (first, second) {
+            (0xFF, 0xFA) => Some(Kind::Telemetry(Stream::Imu)),
+            (0xFF, 0xFB) => Some(Kind::Telemetry(Stream::Encoders)),
+            (0xFF, 0xFC) => Some(Kind::Telemetry(Stream::Battery)),
+            (Reply::HEADER, code) if Register::from_reply_code(code).is_some() => Some(Kind::Reply),
+            _ => None,
+        }
+    }
+
+    /// Whether `first` can start a frame (`FF` or `23`).
+    #[must_use]
+    pub const fn may_start(first: u8) -> bool {
+        first == 0xFF || first == Reply::HEADER
+    }
+
+    /// The frame's length on the wire.
+    #[must_use]
+    pub const fn len(self) -> usize {
+        match self {
+            Kind::Telemetry(Stream::Imu) => Imu::LEN,
+            Kind::Telemetry(Stream::Encoders) => Encoders::LEN,
+            Kind::Telemetry(Stream::Battery) => Battery::LEN,
+            Kind::Reply => Reply::LEN,
+        }
+    }
+
+    /// Always `false` (here for symmetry with [`Kind::len`]).
+    #[must_use]
+    pub const fn is_empty(self) -> bool {
+        false
+    }
+}
+
+/// Any board → master frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Telemetry {
+    /// `FF FA`.
+    Imu(Imu),
+    /// `FF FB`.
+    Encoders(Encoders),
+    /// `FF FC`.
+    Battery(Battery),
+    /// `23`.
+    Reply(Reply),
+}
+
+impl Telemetry {
+    /// The frame's kind.
+    #[must_use]
+    pub const fn kind(&self) -> Kind {
+        match self {
+            Telemetry::Imu(_) => Kind::Telemetry(Stream::Imu),
+            Telemetry::Encoders(_) => Kind::Telemetry(Stream::Encoders),
+            Telemetry::Battery(_) => Kind::Telemetry(Stream::Battery),
+            Telemetry::Reply(_) => Kind::Reply,
+        }
+    }
+
+    /// The rolling count, for telemetry; `None` for a reply.
+    #[must_use]
+    pub const fn seq(&self) -> Option<u8> {
+        match self {
+            Telemetry::Imu(f) => Some(f.seq),
+            Telemetry::Encoders(f) => Some(f.seq),
+            Telemetry::Battery(f) => Some(f.seq),
+            Telemetry::Reply(_) => None,
+        }
+    }
+
+    /// The frame's bytes.
+    #[must_use]
+    pub fn encode(&self) -> TelemetryBytes {
+        match self {
+            Telemetry::Imu(f) => TelemetryBytes::new(&f.encode()),
+            Telemetry::Encoders(f) => TelemetryBytes::new(&f.encode()),
+            Telemetry::Battery(f) => TelemetryBytes::new(&f.encode()),
+            Telemetry::Reply(f) => TelemetryBytes::new(&f.encode()),
+        }
+    }
+
+    /// Decodes exactly one frame of any kind. Unlike [`Kind::from_header`], a reply with an
+    /// unknown code decodes (it is kept, not rejected).
+    pub fn decode(bytes: &[u8]) -> Result<Self, Error> {
+        match bytes {
+            [0xFF, 0xFA, ..] => Imu::decode(bytes).map(Telemetry::Imu),
+            [0xFF, 0xFB, ..] => Encoders::decode(bytes).map(Telemetry::Encoders),
+            [0xFF, 0xFC, ..] => Battery::decode(bytes).map(Telemetry::Battery),
+            [Reply::HEADER, ..] => Reply::decode(bytes).map(Telemetry::Reply),
+            [] | [0xFF] => Err(Error::Length),
+            _ => Err(Error::Header),
+        }
+    }
+}
+
+impl From<Imu> for Telemetry {
+    fn from(f: Imu) -> Self {
+        Telemetry::Imu(f)
+    }
+}
+
+impl From<Encoders> for Telemetry {
+    fn from(f: Encoders) -> Self {
+        Telemetry::Encoders(f)
+    }
+}
+
+impl From<Battery> for Telemetry {
+    fn from(f: Battery) -> Self {
+        Telemetry::Battery(f)
+    }
+}
+
+impl From<Reply> for Telemetry {
+    fn from(f: Reply) -> Self {
+        Telemetry::Reply(f)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kinds_from_headers() {
+        assert_eq!(
+            Kind::from_header(0xFF, 0xFA),
+            Some(Kind::Telemetry(Stream::Imu))
+        );
+        assert_eq!(
+            Kind::from_header(0xFF, 0xFB),
+            Some(Kind::Telemetry(Stream::Encoders))
+        );
+        assert_eq!(
+            Kind::from_header(0xFF, 0xFC),
+            Some(Kind::Telemetry(Stream::Battery))
+        );
+        assert_eq!(Kind::from_header(0xFF, 0xFE), None);
+        assert_eq!(Kind::from_header(0xFF, 0xFD), None);
+        assert_eq!(Kind::from_header(0x23, 0x20), Some(Kind::Reply));
+        assert_eq!(Kind::from_header(0x23, 0x02), None);
+        let lens =
+            [Stream::Imu, Stream::Encoders, Stream::Battery].map(|s| Kind::Telemetry(s).len());
+        assert_eq!(lens, [15, 11, 7]);
+        assert_eq!(Kind::Reply.len(), 6);
+    }
+
+    #[test]
+    fn decode_any() {
+        let battery = [0xFF, 0xFC, 0x04, 0x4C, 0x00, 0x57, 0x03];
+        let frame = Telemetry::decode(&battery).unwrap();
+        assert_eq!(frame.kind(), Kind::Telemetry(Stream::Battery));
+        assert_eq!(frame.seq(), Some(3));
+        assert_eq!(frame.encode().as_slice(), &battery);
+        assert_eq!(Telemetry::decode(&[0xFF]), Err(Error::Length));
+        assert_eq!(
+            Telemetry::decode(&[0xFF, 0xFE, 0, 0, 0, 0, 0]),
+            Err(Error::Header)
+        );
+        assert_eq!(
+            Telemetry::decode(&[0x23, 0x99, 0, 0, 0, 0]).map(|f| f.seq()),
+            Ok(None)
+        );
+    }
+
+    #[test]
+    fn stream_indexes() {
+        for (i, s) in Stream::ALL.iter().enumerate() {
+            assert_eq!(s.index(), i);
+        }
+    }
+}
