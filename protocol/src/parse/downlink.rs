@@ -19,49 +19,64 @@
 //! # States
 //!
 //! ```text
-//!              frame accepted                       count continues
-//!   Hunting ───────────────────────► Tentative ─────────────────────► Locked
-//!      ▲   (header + what follows +      │    (the next frame's count      │
-//!      │    a plausible count)           │     follows its stream)         │
-//!      │                                 │                                 │
-//!      └──────────── candidate rejected: drop its first byte, rescan ◄─────┘
+//!             frame accepted                      CONFIRMATIONS frames continue their counts
+//!   Hunting ─────────────────────► Tentative ───────────────────────────────────► Locked
+//!      ▲   (header + what follows            │                                       │
+//!      │    + a plausible count)              │                                       │
+//!      └────────── candidate rejected: drop its first byte, rescan ◄──────────────────┘
 //! ```
 //!
-//! * **Hunting**: alignment unknown. A candidate frame is accepted when the next two bytes are a
-//!   header *and* its count is plausible: within a few steps after the last count of its stream
-//!   (the window widens with the bytes thrown away since the last frame, about one step per
-//!   15 bytes, since that many frames may have been lost), or it is a reply, or no stream has a
-//!   count yet (start-up). After [`FORGET_AFTER`] bytes thrown away without a frame the parser
-//!   forgets the counts (the board may have restarted), so it can never stay stuck.
-//! * **Tentative** and **Locked**: aligned: a frame is expected to start right here. A frame
-//!   whose count follows its stream, or a reply, is emitted **on its last byte** (no added
-//!   latency) and confirms the lock. Any other complete frame waits for the next two bytes to
-//!   prove to be a header; then a small count gap (frames lost upstream, a corrupted count byte)
-//!   or a stream's first frame is accepted in both states, but a count *jump* only while
-//!   Locked, and it demotes the lock to Tentative. A Tentative lock rests on a hunt's evidence
-//!   alone: a jump there means the alignment is false (a gyro at rest repeats `FF FA` at the
-//!   same place in every IMU frame, so a false alignment can look periodic), and the parser
-//!   goes hunting. [`DownlinkParser::lock`] tells the states apart, for callers that want to
-//!   trust only confirmed data.
-//! * A rejected candidate — bad header where one was expected, bad following header, implausible
-//!   count while hunting — costs exactly **one** byte: its first. Scanning starts again at the
-//!   byte after it, over the bytes already in the window, so a real frame that a false
-//!   candidate overlapped is still found. Nothing is thrown away a frame at a time.
+//! * **Hunting**: alignment unknown; scanning for a frame.
+//! * **Tentative**: aligned by a hunt (or by a quiet line, see [`DownlinkParser::idle`]), not yet
+//!   confirmed. It must see a frame continue its count at least every [`PROBATION_FRAMES`]
+//!   frames, or it is dropped.
+//! * **Locked**: [`CONFIRMATIONS`] frames of this alignment continued their counts.
+//!
+//! [`DownlinkParser::lock`] tells the states apart, for callers that want to trust only
+//! confirmed data.
+//!
+//! # Rules
+//!
+//! A candidate needs a header (which fixes its length) and all its bytes. Then its count is
+//! compared with its stream's last count: it **continues** it (+1), is **near** it (+2 up to
+//! [`NEAR_STEPS`], one more step for every [`BYTES_PER_LOST_FRAME`] bytes since the last frame that
+//! continued its count, at least [`LOCKED_STEPS`] while Locked), is **far** from it, or there is
+//! no count to compare with (the stream's first frame; or a *provisional* count, below).
+//!
+//! | state | on its last byte | two bytes later, if they are a header (or the line is quiet) | otherwise |
+//! |---|---|---|---|
+//! | Hunting | — | count continues, near or provisional; a reply holding no header in its value; a stream's first frame while no count is trusted | reject |
+//! | Tentative | count continues; a reply holding no header | anything but a far count (while on probation) | reject |
+//! | Locked | count continues; a reply holding no header | anything; a far count is rejected but its stream's count stops being trusted | reject |
+//!
+//! * A rejected candidate costs exactly **one** byte: its first. Scanning starts again at the
+//!   byte after it, over the bytes already in the window, so a real frame that a false candidate
+//!   overlapped is still found. Nothing is ever thrown away a frame at a time.
+//! * A count is **trusted** when it continued the stream's previous count, or when its frame was
+//!   taken on a confirmed (Locked) alignment without a jump. Any other count is **provisional**:
+//!   it confirms a later frame that continues it, but never counts against one.
+//! * After [`FORGET_AFTER`] bytes without a single frame that continues its count, every count is
+//!   forgotten (the board may have restarted; a false alignment may have taught a false count).
+//!   That bounds how long anything can hold the parser off: it can never stay stuck.
+//! * A reply whose value bytes hold `FF FA`..`FF FC`, or end in `FF` or `23`, could be a
+//!   truncated reply with the next frame's start in it: it waits for the next header.
 //!
 //! # The trade-off chosen
 //!
-//! Latency is spent only where evidence is missing: while aligned and counts follow, every
-//! frame comes out on its last byte. While hunting, a frame comes out two bytes late (when the
-//! next header arrives) and needs a plausible count, which is what keeps false frames rare: the
-//! false candidates that damaged frames are full of must pass a 16-bit header, a count check of
-//! a few in 256, and a following header. A reply at the very end of a burst while hunting waits
-//! for the next byte or for [`DownlinkParser::idle`]. The measured figures (recall and false
-//! frames per million against noise) are produced by the noise sweep in `chassis-host-tests`.
+//! Latency is spent only where evidence is missing. While aligned and counts continue, every
+//! frame comes out on its last byte. Otherwise a frame comes out two bytes late, once the next
+//! header proves the boundary, and while hunting it also needs a plausible count: that is what
+//! keeps false frames rare, since the false candidates that damaged frames are full of must pass
+//! a 16-bit header, a count check of a few in 256, and a following header. The price is paid at
+//! start-up, when no count is known: a parser that starts listening in the middle of a frame has
+//! only the headers to go by, and a payload dense with false headers can fool it for a frame or
+//! two (the counts expose it right after). The measured figures (recall and false frames per
+//! million against noise) are produced by the noise sweep in `chassis-host-tests`.
 //!
 //! # Memory and time
 //!
-//! The parsing state is 26 bytes (asserted at compile time to stay at most 32); the counters are
-//! a separate [`DownlinkStats`] (68 bytes). Each byte costs a header check and, on a frame's last
+//! The parsing state is 30 bytes (asserted at compile time to stay at most 32); the counters are
+//! a separate [`DownlinkStats`] (52 bytes). Each byte costs a header check and, on a frame's last
 //! byte, a decode of at most 15 bytes and a shift of the window of at most 17 bytes. Nothing
 //! allocates.
 //!
@@ -77,14 +92,27 @@ use crate::telemetry::{self, Kind, Stream, Telemetry};
 const WINDOW: usize = telemetry::MAX_LEN + 2;
 
 /// While hunting, a count may follow its stream's last count by 1 up to this many steps, plus
-/// one step for every [`BYTES_PER_LOST_FRAME`] bytes thrown away since the last frame.
+/// one step for every [`BYTES_PER_LOST_FRAME`] bytes received since the last confirmed frame.
 pub const NEAR_STEPS: u8 = 2;
 
-/// How many bytes thrown away widen the plausible count window by one step (the longest frame).
+/// While Locked, a count may jump by up to this many steps (frames lost upstream) and still be
+/// trusted, once the next header proves the boundary.
+pub const LOCKED_STEPS: u8 = 8;
+
+/// How many bytes widen the plausible count window by one step (the longest frame).
 pub const BYTES_PER_LOST_FRAME: u16 = telemetry::MAX_LEN as u16;
 
-/// After this many bytes thrown away without a frame, the counts are forgotten.
-pub const FORGET_AFTER: u16 = 512;
+/// After this many bytes without a frame that continues its count, the counts are forgotten
+/// (the board may have restarted, or a false alignment taught false counts): the parser can
+/// never stay stuck.
+pub const FORGET_AFTER: u16 = 160;
+
+/// A Tentative lock becomes Locked after this many frames whose count follows their stream.
+pub const CONFIRMATIONS: u8 = 2;
+
+/// A Tentative lock must see a frame continue its count at least every this many frames, or the
+/// next frame that does not is rejected and the parser hunts again.
+pub const PROBATION_FRAMES: u8 = 4;
 
 /// How sure the parser is of where frames start.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -92,9 +120,9 @@ pub const FORGET_AFTER: u16 = 512;
 pub enum Lock {
     /// Alignment unknown: scanning for a frame.
     Hunting,
-    /// Aligned by a hunt, not yet confirmed by a frame whose count follows its stream.
+    /// Aligned by a hunt (or by a quiet line), not yet confirmed by counts.
     Tentative,
-    /// Aligned and confirmed by a count.
+    /// Aligned and confirmed: [`CONFIRMATIONS`] frames in a row of it continued their counts.
     Locked,
 }
 
@@ -104,14 +132,22 @@ struct State {
     /// Bytes from the first byte of the candidate being judged.
     window: Window<WINDOW>,
     lock: Lock,
-    /// Bit `i` set: `last_seq[i]` holds the last count of stream `i`.
+    /// Bit `i` set: `last_seq[i]` holds a count of stream `i` (IMU, encoders, battery).
     seen: u8,
-    /// The last count of each stream (IMU, encoders, battery).
+    /// Bit `i` set: stream `i`'s count is provisional: learnt on an alignment not yet
+    /// confirmed, or a jump, or from before a quiet line. It confirms a frame that continues it
+    /// but never counts against one that does not.
+    provisional: u8,
+    /// The last count of each stream.
     last_seq: [u8; 3],
-    /// Bytes thrown away since the last frame emitted (saturating).
-    skipped: u16,
+    /// While Tentative: frames so far whose count continued their stream.
+    confirms: u8,
+    /// While Tentative: frames accepted since the last one that continued its count.
+    probation: u8,
     /// The last `poll` emitted a frame: another may be ready without a new byte.
     drain: bool,
+    /// Bytes received since the last frame that continued its count (saturating).
+    since_confirmed: u16,
 }
 
 const _: () = assert!(
@@ -125,6 +161,10 @@ enum Verdict {
     NeedMore,
     /// The first byte starts no frame: drop it.
     Reject,
+    /// A frame at a confirmed boundary whose count jumps: drop its first byte too, and stop
+    /// trusting that stream's count (the board may have restarted it), so the stream's next
+    /// frame is not held against it.
+    Doubt(Stream),
     /// A frame of this length.
     Accept(Telemetry, usize),
 }
@@ -138,7 +178,9 @@ enum Continuity {
     Unknown,
     /// Exactly the next count.
     Continues,
-    /// A few counts on (see [`NEAR_STEPS`]).
+    /// Not the next count, but the stream's count is provisional: no evidence either way.
+    Provisional,
+    /// A few counts on from a trusted count (see [`NEAR_STEPS`]).
     Near,
     /// Anything else.
     Far,
@@ -186,9 +228,12 @@ impl DownlinkParser {
                 window: Window::new(),
                 lock: Lock::Hunting,
                 seen: 0,
+                provisional: 0,
                 last_seq: [0; 3],
-                skipped: 0,
+                confirms: 0,
+                probation: 0,
                 drain: false,
+                since_confirmed: 0,
             },
             stats: DownlinkStats::new(),
         }
@@ -251,6 +296,7 @@ impl DownlinkParser {
                     return None;
                 }
                 Verdict::Reject => self.reject(),
+                Verdict::Doubt(stream) => self.doubt(stream),
                 Verdict::Accept(frame, len) => {
                     self.accept(&frame, len);
                     self.state.drain = true;
@@ -276,9 +322,13 @@ impl DownlinkParser {
                     if self.state.lock == Lock::Hunting {
                         self.state.lock = Lock::Tentative;
                     }
+                    // The board may have paused its telemetry (it does while settings are
+                    // made): the counts may jump, so they no longer count against a frame.
+                    self.state.provisional = self.state.seen;
                     return None;
                 }
                 Verdict::Reject => self.reject(),
+                Verdict::Doubt(stream) => self.doubt(stream),
                 Verdict::Accept(frame, len) => {
                     self.accept(&frame, len);
                     self.state.drain = true;
@@ -327,6 +377,14 @@ impl DownlinkParser {
             }
             let taken = self.state.window.extend(bytes);
             bytes = bytes.get(taken..).unwrap_or(&[]);
+            let state = &mut self.state;
+            let taken = u16::try_from(taken).unwrap_or(u16::MAX);
+            state.since_confirmed = state.since_confirmed.saturating_add(taken);
+            if state.since_confirmed >= FORGET_AFTER {
+                state.seen = 0;
+                state.provisional = 0;
+                state.since_confirmed = 0;
+            }
         }
     }
 
@@ -344,29 +402,41 @@ impl DownlinkParser {
 
     /// How `frame`'s count relates to its stream's last one.
     fn continuity(&self, frame: &Telemetry) -> Continuity {
+        let state = &self.state;
         let (Some(seq), Kind::Telemetry(stream)) = (frame.seq(), frame.kind()) else {
             return Continuity::Reply;
         };
-        let i = stream.index();
-        if self.state.seen & (1 << i) == 0 {
+        let bit = 1u8 << stream.index();
+        if state.seen & bit == 0 {
             return Continuity::Unknown;
         }
-        let last = self.state.last_seq.get(i).copied().unwrap_or(0);
+        let last = state.last_seq.get(stream.index()).copied().unwrap_or(0);
         let step = seq.wrapping_sub(last);
-        let widen = self.state.skipped / BYTES_PER_LOST_FRAME;
-        let near = u16::from(NEAR_STEPS).saturating_add(widen);
-        match step {
-            1 => Continuity::Continues,
-            0 => Continuity::Far,
-            s if u16::from(s) <= near => Continuity::Near,
-            _ => Continuity::Far,
+        if step == 1 {
+            return Continuity::Continues;
+        }
+        if state.provisional & bit != 0 {
+            return Continuity::Provisional;
+        }
+        // Frames may have been lost in the bytes before this candidate.
+        let before = usize::from(state.since_confirmed).saturating_sub(state.window.len());
+        let widen = u16::try_from(before).unwrap_or(u16::MAX) / BYTES_PER_LOST_FRAME;
+        let mut near = u16::from(NEAR_STEPS).saturating_add(widen);
+        if state.lock == Lock::Locked {
+            near = near.max(u16::from(LOCKED_STEPS));
+        }
+        if step != 0 && u16::from(step) <= near {
+            Continuity::Near
+        } else {
+            Continuity::Far
         }
     }
 
     /// Judges the candidate at the front of the window. `idle`: the line has gone quiet, so no
     /// more bytes are coming for now.
     fn judge(&self, idle: bool) -> Verdict {
-        let buf = self.state.window.as_slice();
+        let state = &self.state;
+        let buf = state.window.as_slice();
         let (first, second) = match buf {
             [] => return Verdict::NeedMore,
             [first] if Kind::may_start(*first) && !idle => return Verdict::NeedMore,
@@ -388,22 +458,45 @@ impl DownlinkParser {
             return Verdict::Reject;
         };
         let continuity = self.continuity(&frame);
-        let aligned = self.state.lock != Lock::Hunting;
-        if aligned && matches!(continuity, Continuity::Continues | Continuity::Reply) {
+        // A truncated reply would hold the next frame's header in its value bytes.
+        let clean_reply = !holds_a_frame_start(bytes.get(2..).unwrap_or(&[]));
+        let aligned = state.lock != Lock::Hunting;
+
+        // On the frame's last byte, when the evidence is already there.
+        let at_once = aligned
+            && match continuity {
+                Continuity::Continues => true,
+                Continuity::Reply => clean_reply,
+                _ => false,
+            };
+        if at_once {
             return Verdict::Accept(frame, len);
         }
+
+        // Otherwise the next two bytes must be a header (or the line must be quiet)...
         let followed = match buf.get(len..) {
             Some([next, after, ..]) => Kind::from_header(*next, *after).is_some(),
             Some([next]) if !Kind::may_start(*next) => false,
             _ if idle => true,
             _ => return Verdict::NeedMore,
         };
-        let plausible = match continuity {
-            Continuity::Reply | Continuity::Continues | Continuity::Near => true,
-            // A stream's first frame: proof enough while aligned, or when nothing is known yet.
-            Continuity::Unknown => aligned || self.state.seen == 0,
-            // Only a confirmed lock takes a count jump (telemetry paused, frames lost upstream).
-            Continuity::Far => self.state.lock == Lock::Locked,
+        // ...and the count plausible for the state the parser is in.
+        let plausible = match state.lock {
+            Lock::Hunting => match continuity {
+                Continuity::Continues | Continuity::Near | Continuity::Provisional => true,
+                // Could be a frame's tail and the next frame's start: the driver asks again.
+                Continuity::Reply => clean_reply,
+                // A stream's first frame: proof enough only while no count is trusted yet.
+                Continuity::Unknown => state.seen & !state.provisional == 0,
+                Continuity::Far => false,
+            },
+            Lock::Tentative => state.probation < PROBATION_FRAMES && continuity != Continuity::Far,
+            Lock::Locked => match (continuity, frame.kind()) {
+                (Continuity::Far, Kind::Telemetry(stream)) if followed => {
+                    return Verdict::Doubt(stream);
+                }
+                _ => true,
+            },
         };
         if followed && plausible {
             Verdict::Accept(frame, len)
@@ -412,15 +505,17 @@ impl DownlinkParser {
         }
     }
 
+    /// Rejects a candidate for its count alone, and stops trusting that count.
+    fn doubt(&mut self, stream: Stream) {
+        self.state.provisional |= 1 << stream.index();
+        self.reject();
+    }
+
     /// Drops the candidate's first byte and goes hunting.
     fn reject(&mut self) {
         let state = &mut self.state;
         state.window.drop_front(1);
         self.stats.discarded = self.stats.discarded.wrapping_add(1);
-        state.skipped = state.skipped.saturating_add(1);
-        if state.skipped >= FORGET_AFTER {
-            state.seen = 0;
-        }
         if state.lock != Lock::Hunting {
             self.stats.lock_losses = self.stats.lock_losses.wrapping_add(1);
             state.lock = Lock::Hunting;
@@ -432,26 +527,53 @@ impl DownlinkParser {
         let continuity = self.continuity(frame);
         let state = &mut self.state;
         state.window.drop_front(len);
-        state.skipped = 0;
         self.stats.count_frame(frame.kind());
-        if let (Some(seq), Kind::Telemetry(stream)) = (frame.seq(), frame.kind()) {
-            record_seq(state, &mut self.stats, stream, seq);
+        let confirms = continuity == Continuity::Continues;
+        if confirms {
+            let after = u16::try_from(state.window.len()).unwrap_or(0);
+            state.since_confirmed = after;
         }
-        state.lock = match (state.lock, continuity) {
-            (Lock::Hunting, _) => {
+        match state.lock {
+            Lock::Hunting => {
                 self.stats.resyncs = self.stats.resyncs.wrapping_add(1);
-                Lock::Tentative
+                state.lock = Lock::Tentative;
+                state.confirms = u8::from(confirms);
+                state.probation = u8::from(!confirms);
             }
-            (_, Continuity::Continues) => Lock::Locked,
-            // A count jump is taken on the next frame's header alone: no longer confirmed.
-            (_, Continuity::Far) => Lock::Tentative,
-            (lock, _) => lock,
-        };
+            Lock::Tentative if confirms => {
+                state.confirms = state.confirms.saturating_add(1);
+                state.probation = 0;
+            }
+            Lock::Tentative => state.probation = state.probation.saturating_add(1),
+            Lock::Locked => {}
+        }
+        if state.lock == Lock::Tentative && state.confirms >= CONFIRMATIONS {
+            state.lock = Lock::Locked;
+        }
+        if let (Some(seq), Kind::Telemetry(stream)) = (frame.seq(), frame.kind()) {
+            // A count is trusted when it continues the last one (a false frame does that about
+            // one time in 256), or when its frame sits on a confirmed alignment and does not jump.
+            let trusted = confirms || (state.lock == Lock::Locked && continuity != Continuity::Far);
+            record_seq(state, &mut self.stats, stream, seq, trusted);
+        }
     }
 }
 
+/// Whether `bytes` hold what could be the start of the next frame: `FF FA`..`FF FC`, or a
+/// last byte `FF` or `23`.
+fn holds_a_frame_start(bytes: &[u8]) -> bool {
+    let pair = bytes.windows(2).any(|w| matches!(w, [0xFF, 0xFA..=0xFC]));
+    pair || matches!(bytes.last(), Some(&b) if Kind::may_start(b))
+}
+
 /// Stores a stream's new count and counts the gap before it, if any.
-fn record_seq(state: &mut State, stats: &mut DownlinkStats, stream: Stream, seq: u8) {
+fn record_seq(
+    state: &mut State,
+    stats: &mut DownlinkStats,
+    stream: Stream,
+    seq: u8,
+    trusted: bool,
+) {
     let i = stream.index();
     let bit = 1u8 << i;
     if let Some(last) = state.last_seq.get_mut(i) {
@@ -463,6 +585,11 @@ fn record_seq(state: &mut State, stats: &mut DownlinkStats, stream: Stream, seq:
         }
         *last = seq;
         state.seen |= bit;
+        if trusted {
+            state.provisional &= !bit;
+        } else {
+            state.provisional |= bit;
+        }
     }
 }
 
@@ -503,7 +630,8 @@ mod tests {
     #[test]
     fn state_size() {
         assert!(core::mem::size_of::<State>() <= 32);
-        assert_eq!(core::mem::size_of::<State>(), 26);
+        assert_eq!(core::mem::size_of::<State>(), 30);
+        assert_eq!(core::mem::size_of::<DownlinkStats>(), 52);
     }
 
     #[test]
@@ -519,9 +647,11 @@ mod tests {
         // The second continues the count: out on its last byte, and the lock is confirmed.
         assert_eq!(feed(&mut p, &b[2..14]), vec![]);
         assert_eq!(p.push(b[14]), Some(Telemetry::Imu(imu(2, 0))));
-        assert_eq!(p.lock(), Lock::Locked);
+        assert_eq!(p.lock(), Lock::Tentative);
         assert_eq!(feed(&mut p, &c[..14]), vec![]);
         assert_eq!(p.push(c[14]), Some(Telemetry::Imu(imu(3, 0))));
+        // Two frames in a row have continued their counts: the lock is confirmed.
+        assert_eq!(p.lock(), Lock::Locked);
         assert_eq!(p.buffered(), 0);
         assert_eq!(p.stats().discarded, 0);
     }
@@ -529,8 +659,9 @@ mod tests {
     #[test]
     fn a_reply_while_aligned_comes_out_at_once() {
         let mut p = DownlinkParser::new();
-        feed(&mut p, &imu(1, 0).encode());
-        feed(&mut p, &imu(2, 0).encode());
+        for seq in 1..=3 {
+            feed(&mut p, &imu(seq, 0).encode());
+        }
         let reply = Reply::new(Register::MaxSpeed, 500);
         let out = feed(&mut p, &reply.encode());
         assert_eq!(out, vec![Telemetry::Reply(reply)]);
