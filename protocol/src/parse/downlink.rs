@@ -38,16 +38,16 @@
 //! # Rules
 //!
 //! A candidate needs a header (which fixes its length) and all its bytes. Then its count is
-//! compared with its stream's last count: it **continues** it (+1), is **near** it (+2 up to
-//! [`NEAR_STEPS`], one more step for every [`BYTES_PER_LOST_FRAME`] bytes since the last frame that
-//! continued its count, at least [`LOCKED_STEPS`] while Locked), is **far** from it, or there is
+//! compared with its stream's last count: it **continues** it (+1), is **near** it (up to
+//! [`NEAR_STEPS`] for its stream, one more step for every [`BYTES_PER_FRAME`] of its stream
+//! received since the last confirmed frame; at least [`LOCKED_STEPS`] while Locked), is **far** from it, or there is
 //! no count to compare with (the stream's first frame; or a *provisional* count, below).
 //!
 //! | state | on its last byte | two bytes later, if they are a header (or the line is quiet) | otherwise |
 //! |---|---|---|---|
 //! | Hunting | — | count continues, near or provisional; a reply holding no header in its value; a stream's first frame while no count is trusted | reject |
-//! | Tentative | count continues; a reply holding no header | anything but a far count (while on probation) | reject |
-//! | Locked | count continues; a reply holding no header | anything; a far count is rejected but its stream's count stops being trusted | reject |
+//! | Tentative | count continues; a reply holding no header | anything but a far count (at most PROBATION_FRAMES in a row without a count that continues) | reject |
+//! | Locked | count continues; a reply holding no header | anything; a far count only right after a frame whose count continued | reject |
 //!
 //! * A rejected candidate costs exactly **one** byte: its first. Scanning starts again at the
 //!   byte after it, over the bytes already in the window, so a real frame that a false candidate
@@ -75,7 +75,7 @@
 //!
 //! # Memory and time
 //!
-//! The parsing state is 30 bytes (asserted at compile time to stay at most 32); the counters are
+//! The parsing state is 32 bytes (asserted at compile time to stay at most 32); the counters are
 //! a separate [`DownlinkStats`] (52 bytes). Each byte costs a header check and, on a frame's last
 //! byte, a decode of at most 15 bytes and a shift of the window of at most 17 bytes. Nothing
 //! allocates.
@@ -91,16 +91,19 @@ use crate::telemetry::{self, Kind, Stream, Telemetry};
 /// Bytes kept: the longest frame and the two bytes after it.
 const WINDOW: usize = telemetry::MAX_LEN + 2;
 
-/// While hunting, a count may follow its stream's last count by 1 up to this many steps, plus
-/// one step for every [`BYTES_PER_LOST_FRAME`] bytes received since the last confirmed frame.
-pub const NEAR_STEPS: u8 = 2;
+/// While hunting, how far past its stream's last count a count may be, per stream (IMU,
+/// encoders, battery), before any allowance for lost frames: one frame of the stream may have
+/// been in the damaged stretch, except for the battery, whose frames are a second apart.
+pub const NEAR_STEPS: [u8; 3] = [2, 2, 1];
+
+/// Bytes of the stream per frame of each stream (IMU, encoders, battery), rounded down from the
+/// board's rates (100 / 25 / 1 Hz, 1 782 bytes/s in all): each such stretch received since the
+/// last confirmed frame allows one more step.
+pub const BYTES_PER_FRAME: [u16; 3] = [15, 60, 1_500];
 
 /// While Locked, a count may jump by up to this many steps (frames lost upstream) and still be
 /// trusted, once the next header proves the boundary.
 pub const LOCKED_STEPS: u8 = 8;
-
-/// How many bytes widen the plausible count window by one step (the longest frame).
-pub const BYTES_PER_LOST_FRAME: u16 = telemetry::MAX_LEN as u16;
 
 /// After this many bytes without a frame that continues its count, the counts are forgotten
 /// (the board may have restarted, or a false alignment taught false counts): the parser can
@@ -140,13 +143,16 @@ struct State {
     provisional: u8,
     /// The last count of each stream.
     last_seq: [u8; 3],
+    /// The last count jump taken on a confirmed alignment: (stream index, count received).
+    jump: Option<(u8, u8)>,
     /// While Tentative: frames so far whose count continued their stream.
     confirms: u8,
-    /// While Tentative: frames accepted since the last one that continued its count.
-    probation: u8,
+    /// Frames accepted since the last one that continued its count (saturating).
+    since_continued: u8,
     /// The last `poll` emitted a frame: another may be ready without a new byte.
     drain: bool,
-    /// Bytes received since the last frame that continued its count (saturating).
+    /// Bytes received since the last frame that continued its count on a Locked alignment
+    /// (saturating).
     since_confirmed: u16,
 }
 
@@ -161,10 +167,6 @@ enum Verdict {
     NeedMore,
     /// The first byte starts no frame: drop it.
     Reject,
-    /// A frame at a confirmed boundary whose count jumps: drop its first byte too, and stop
-    /// trusting that stream's count (the board may have restarted it), so the stream's next
-    /// frame is not held against it.
-    Doubt(Stream),
     /// A frame of this length.
     Accept(Telemetry, usize),
 }
@@ -230,8 +232,9 @@ impl DownlinkParser {
                 seen: 0,
                 provisional: 0,
                 last_seq: [0; 3],
+                jump: None,
                 confirms: 0,
-                probation: 0,
+                since_continued: 0,
                 drain: false,
                 since_confirmed: 0,
             },
@@ -296,7 +299,6 @@ impl DownlinkParser {
                     return None;
                 }
                 Verdict::Reject => self.reject(),
-                Verdict::Doubt(stream) => self.doubt(stream),
                 Verdict::Accept(frame, len) => {
                     self.accept(&frame, len);
                     self.state.drain = true;
@@ -328,7 +330,6 @@ impl DownlinkParser {
                     return None;
                 }
                 Verdict::Reject => self.reject(),
-                Verdict::Doubt(stream) => self.doubt(stream),
                 Verdict::Accept(frame, len) => {
                     self.accept(&frame, len);
                     self.state.drain = true;
@@ -402,6 +403,11 @@ impl DownlinkParser {
 
     /// How `frame`'s count relates to its stream's last one.
     fn continuity(&self, frame: &Telemetry) -> Continuity {
+        self.continuity_given(frame, self.state.provisional)
+    }
+
+    /// [`continuity`](Self::continuity), with `provisional` as the set of provisional counts.
+    fn continuity_given(&self, frame: &Telemetry, provisional: u8) -> Continuity {
         let state = &self.state;
         let (Some(seq), Kind::Telemetry(stream)) = (frame.seq(), frame.kind()) else {
             return Continuity::Reply;
@@ -415,13 +421,19 @@ impl DownlinkParser {
         if step == 1 {
             return Continuity::Continues;
         }
-        if state.provisional & bit != 0 {
+        if provisional & bit != 0 {
             return Continuity::Provisional;
         }
         // Frames may have been lost in the bytes before this candidate.
         let before = usize::from(state.since_confirmed).saturating_sub(state.window.len());
-        let widen = u16::try_from(before).unwrap_or(u16::MAX) / BYTES_PER_LOST_FRAME;
-        let mut near = u16::from(NEAR_STEPS).saturating_add(widen);
+        let i = stream.index();
+        let per_frame = BYTES_PER_FRAME.get(i).copied().unwrap_or(u16::MAX).max(1);
+        let widen = u16::try_from(before)
+            .unwrap_or(u16::MAX)
+            .checked_div(per_frame)
+            .unwrap_or(0);
+        let base = NEAR_STEPS.get(i).copied().unwrap_or(1);
+        let mut near = u16::from(base).saturating_add(widen);
         if state.lock == Lock::Locked {
             near = near.max(u16::from(LOCKED_STEPS));
         }
@@ -430,6 +442,15 @@ impl DownlinkParser {
         } else {
             Continuity::Far
         }
+    }
+
+    /// While hunting, a provisional count still says where the stream was: whether `frame`'s
+    /// count is near it, as if it were trusted.
+    fn provisional_near(&self, frame: &Telemetry) -> bool {
+        matches!(
+            self.continuity_given(frame, 0),
+            Continuity::Continues | Continuity::Near
+        )
     }
 
     /// Judges the candidate at the front of the window. `idle`: the line has gone quiet, so no
@@ -483,32 +504,29 @@ impl DownlinkParser {
         // ...and the count plausible for the state the parser is in.
         let plausible = match state.lock {
             Lock::Hunting => match continuity {
-                Continuity::Continues | Continuity::Near | Continuity::Provisional => true,
+                Continuity::Continues | Continuity::Near => true,
+                // A count learnt in a hunt may be false, but it is the best guess there is.
+                Continuity::Provisional => self.provisional_near(&frame),
                 // Could be a frame's tail and the next frame's start: the driver asks again.
                 Continuity::Reply => clean_reply,
                 // A stream's first frame: proof enough only while no count is trusted yet.
                 Continuity::Unknown => state.seen & !state.provisional == 0,
                 Continuity::Far => false,
             },
-            Lock::Tentative => state.probation < PROBATION_FRAMES && continuity != Continuity::Far,
-            Lock::Locked => match (continuity, frame.kind()) {
-                (Continuity::Far, Kind::Telemetry(stream)) if followed => {
-                    return Verdict::Doubt(stream);
-                }
-                _ => true,
-            },
+            Lock::Tentative => {
+                state.since_continued < PROBATION_FRAMES && continuity != Continuity::Far
+            }
+            // A count jump on a confirmed alignment is taken (its count stays provisional) when
+            // the frame before continued its count: then this boundary is certain, and the jump
+            // is most likely a damaged count byte. After a frame that was taken on weaker
+            // evidence, the boundary itself is in doubt.
+            Lock::Locked => continuity != Continuity::Far || state.since_continued == 0,
         };
         if followed && plausible {
             Verdict::Accept(frame, len)
         } else {
             Verdict::Reject
         }
-    }
-
-    /// Rejects a candidate for its count alone, and stops trusting that count.
-    fn doubt(&mut self, stream: Stream) {
-        self.state.provisional |= 1 << stream.index();
-        self.reject();
     }
 
     /// Drops the candidate's first byte and goes hunting.
@@ -529,32 +547,37 @@ impl DownlinkParser {
         state.window.drop_front(len);
         self.stats.count_frame(frame.kind());
         let confirms = continuity == Continuity::Continues;
-        if confirms {
-            let after = u16::try_from(state.window.len()).unwrap_or(0);
-            state.since_confirmed = after;
-        }
+        state.since_continued = if confirms {
+            0
+        } else {
+            state.since_continued.saturating_add(1)
+        };
         match state.lock {
             Lock::Hunting => {
                 self.stats.resyncs = self.stats.resyncs.wrapping_add(1);
                 state.lock = Lock::Tentative;
                 state.confirms = u8::from(confirms);
-                state.probation = u8::from(!confirms);
             }
-            Lock::Tentative if confirms => {
-                state.confirms = state.confirms.saturating_add(1);
-                state.probation = 0;
-            }
-            Lock::Tentative => state.probation = state.probation.saturating_add(1),
+            Lock::Tentative => state.confirms = state.confirms.saturating_add(u8::from(confirms)),
             Lock::Locked => {}
         }
         if state.lock == Lock::Tentative && state.confirms >= CONFIRMATIONS {
             state.lock = Lock::Locked;
         }
+        if confirms && state.lock == Lock::Locked {
+            // Only a confirmed alignment restarts the clock: until then, the bytes since the
+            // last certain frame tell how many frames may have been lost.
+            state.since_confirmed = u16::try_from(state.window.len()).unwrap_or(0);
+        }
         if let (Some(seq), Kind::Telemetry(stream)) = (frame.seq(), frame.kind()) {
-            // A count is trusted when it continues the last one (a false frame does that about
-            // one time in 256), or when its frame sits on a confirmed alignment and does not jump.
-            let trusted = confirms || (state.lock == Lock::Locked && continuity != Continuity::Far);
-            record_seq(state, &mut self.stats, stream, seq, trusted);
+            if state.lock == Lock::Locked && continuity == Continuity::Far {
+                record_jump(state, &mut self.stats, stream, seq);
+            } else {
+                // A count is trusted when it continues the last one (a false frame does that
+                // about one time in 256), or when its frame sits on a confirmed alignment.
+                let trusted = confirms || state.lock == Lock::Locked;
+                record_seq(state, &mut self.stats, stream, seq, trusted);
+            }
         }
     }
 }
@@ -564,6 +587,25 @@ impl DownlinkParser {
 fn holds_a_frame_start(bytes: &[u8]) -> bool {
     let pair = bytes.windows(2).any(|w| matches!(w, [0xFF, 0xFA..=0xFC]));
     pair || matches!(bytes.last(), Some(&b) if Kind::may_start(b))
+}
+
+/// A count jump on a confirmed alignment, right after a frame whose count continued: most likely
+/// the count byte itself was damaged, so the stream's count moves on by one as if it had not
+/// been. If the same stream jumps again and its new count continues the jumped one, the board
+/// really did move its count on (it restarted, or paused its telemetry): the count follows it.
+fn record_jump(state: &mut State, stats: &mut DownlinkStats, stream: Stream, seq: u8) {
+    let i = stream.index();
+    let Some(last) = state.last_seq.get_mut(i) else {
+        return;
+    };
+    let again = state.jump == Some((i as u8, seq.wrapping_sub(1)));
+    if again {
+        state.jump = None;
+        record_seq(state, stats, stream, seq, true);
+    } else {
+        *last = last.wrapping_add(1);
+        state.jump = u8::try_from(i).ok().map(|i| (i, seq));
+    }
 }
 
 /// Stores a stream's new count and counts the gap before it, if any.
@@ -630,7 +672,7 @@ mod tests {
     #[test]
     fn state_size() {
         assert!(core::mem::size_of::<State>() <= 32);
-        assert_eq!(core::mem::size_of::<State>(), 30);
+        assert_eq!(core::mem::size_of::<State>(), 32);
         assert_eq!(core::mem::size_of::<DownlinkStats>(), 52);
     }
 

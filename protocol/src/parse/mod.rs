@@ -2,7 +2,7 @@
 //!
 //! | parser | direction | emits | state |
 //! |---|---|---|---|
-//! | [`DownlinkParser`] | board → master | [`Telemetry`](crate::Telemetry) | 30 bytes |
+//! | [`DownlinkParser`] | board → master | [`Telemetry`](crate::Telemetry) | 32 bytes |
 //! | [`UplinkParser`] | master → board | [`Command`](crate::Command) | 13 bytes |
 //!
 //! Both are `const fn new()`, take bytes one at a time ([`push`](DownlinkParser::push)) or a

@@ -1,0 +1,234 @@
+//! A realistic board → master byte stream: telemetry at the board's rates, with the payloads of a
+//! chassis at rest or moving slowly (so gyro and accel values sit around zero, and `FF FA`..`FF FC`
+//! turn up inside payloads as on the real board), and `#` replies interleaved.
+//!
+//! Time runs at 115 200 bps (11 520 bytes/s); frames are written back to back, with no idle
+//! line between them: the hardest case for resynchronisation, since a quiet line would mark
+//! every boundary.
+
+use chassis_protocol::{Battery, Encoders, Imu, Register, Reply, Telemetry};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+/// One frame as sent: where it starts in the byte stream, and what it is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SentFrame {
+    /// Offset of its first byte in the sent stream.
+    pub start: usize,
+    /// The frame.
+    pub frame: Telemetry,
+}
+
+impl SentFrame {
+    /// Offset one past its last byte.
+    pub fn end(&self) -> usize {
+        self.start + self.frame.encode().len()
+    }
+}
+
+/// The board's telemetry generator.
+#[derive(Clone, Debug)]
+pub struct BoardStream {
+    rng: Pcg64Mcg,
+    /// Time in microseconds.
+    now_us: u64,
+    next_imu_us: u64,
+    next_encoders_us: u64,
+    next_battery_us: u64,
+    next_reply_us: u64,
+    /// Mean microseconds between replies (0: none).
+    reply_every_us: u64,
+    seq: [u8; 3],
+    wheel_speed: [i16; 4],
+    wheel_total: [i16; 4],
+    centivolts: u16,
+}
+
+impl BoardStream {
+    /// A board that starts at a random phase, with `replies_per_second` replies on average.
+    pub fn new(seed: u64, replies_per_second: f64) -> Self {
+        let mut rng = Pcg64Mcg::seed_from_u64(seed);
+        let reply_every_us = if replies_per_second > 0.0 {
+            (1e6 / replies_per_second) as u64
+        } else {
+            0
+        };
+        let seq = [rng.random(), rng.random(), rng.random()];
+        BoardStream {
+            next_imu_us: rng.random_range(0..10_000),
+            next_encoders_us: rng.random_range(0..40_000),
+            next_battery_us: rng.random_range(0..1_000_000),
+            next_reply_us: if reply_every_us > 0 {
+                rng.random_range(0..reply_every_us)
+            } else {
+                u64::MAX
+            },
+            reply_every_us,
+            rng,
+            now_us: 0,
+            seq,
+            wheel_speed: [0; 4],
+            wheel_total: [0; 4],
+            centivolts: 1_240,
+        }
+    }
+
+    /// A small value around zero, as a sensor at rest reads.
+    fn around_zero(&mut self, spread: i16) -> i16 {
+        self.rng.random_range(-spread..=spread)
+    }
+
+    fn next_seq(&mut self, stream: usize) -> u8 {
+        let slot = &mut self.seq[stream];
+        *slot = slot.wrapping_add(1);
+        *slot
+    }
+
+    fn imu(&mut self) -> Telemetry {
+        let accel = [
+            self.around_zero(40),
+            self.around_zero(40),
+            16_384 + self.around_zero(40),
+        ];
+        let gyro = [
+            self.around_zero(8),
+            self.around_zero(8),
+            self.around_zero(8),
+        ];
+        Telemetry::Imu(Imu {
+            accel,
+            gyro,
+            seq: self.next_seq(0),
+        })
+    }
+
+    fn encoders(&mut self) -> Telemetry {
+        for wheel in 0..4 {
+            let change = self.around_zero(3);
+            self.wheel_speed[wheel] = (self.wheel_speed[wheel] + change).clamp(-40, 40);
+            self.wheel_total[wheel] = self.wheel_total[wheel].wrapping_add(self.wheel_speed[wheel]);
+        }
+        Telemetry::Encoders(Encoders {
+            ticks: self.wheel_total,
+            seq: self.next_seq(1),
+        })
+    }
+
+    fn battery(&mut self) -> Telemetry {
+        self.centivolts = self.centivolts.saturating_sub(self.rng.random_range(0..2));
+        let percent = (self.centivolts.saturating_sub(1_050) / 2).min(100);
+        Telemetry::Battery(Battery {
+            centivolts: self.centivolts,
+            percent,
+            seq: self.next_seq(2),
+        })
+    }
+
+    fn reply(&mut self) -> Telemetry {
+        let register = Register::ALL[self.rng.random_range(0..Register::ALL.len())];
+        let value = match register {
+            Register::PendingAngle => self.rng.random_range(-1_800i32..=1_800) as u32,
+            Register::SystemMode => self.rng.random_range(0..0x1000),
+            Register::BatteryRange => 0x7FFF_7FFF,
+            Register::MotorVoltage => 1_200,
+            _ => self.rng.random_range(0..100_000),
+        };
+        Telemetry::Reply(Reply::new(register, value))
+    }
+
+    /// The next frame the board sends, and advances time past it.
+    pub fn next_frame(&mut self) -> Telemetry {
+        let due = self
+            .next_imu_us
+            .min(self.next_encoders_us)
+            .min(self.next_battery_us)
+            .min(self.next_reply_us);
+        self.now_us = self.now_us.max(due);
+        let frame = if due == self.next_imu_us {
+            self.next_imu_us += 10_000;
+            self.imu()
+        } else if due == self.next_encoders_us {
+            self.next_encoders_us += 40_000;
+            self.encoders()
+        } else if due == self.next_battery_us {
+            self.next_battery_us += 1_000_000;
+            self.battery()
+        } else {
+            let gap = self
+                .rng
+                .random_range(self.reply_every_us / 2..=self.reply_every_us * 3 / 2);
+            self.next_reply_us += gap.max(1);
+            self.reply()
+        };
+        // 86.8 us per byte at 115 200 bps, 8N1.
+        self.now_us += frame.encode().len() as u64 * 1_000_000 / 11_520;
+        frame
+    }
+
+    /// `count` frames, back to back: the bytes, and each frame with its offset.
+    pub fn take(&mut self, count: usize) -> (Vec<u8>, Vec<SentFrame>) {
+        let mut bytes = Vec::with_capacity(count * 15);
+        let mut frames = Vec::with_capacity(count);
+        for _ in 0..count {
+            let frame = self.next_frame();
+            frames.push(SentFrame {
+                start: bytes.len(),
+                frame,
+            });
+            bytes.extend_from_slice(&frame.encode());
+        }
+        (bytes, frames)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use chassis_protocol::{Kind, Stream};
+
+    #[test]
+    fn rates_and_counts_are_the_boards() {
+        let mut board = BoardStream::new(1, 2.0);
+        let (bytes, frames) = board.take(10_000);
+        let count = |k: Kind| frames.iter().filter(|f| f.frame.kind() == k).count() as f64;
+        let imu = count(Kind::Telemetry(Stream::Imu));
+        let encoders = count(Kind::Telemetry(Stream::Encoders));
+        let battery = count(Kind::Telemetry(Stream::Battery));
+        assert!((encoders / imu - 0.25).abs() < 0.01, "{encoders} / {imu}");
+        assert!((battery / imu - 0.01).abs() < 0.002, "{battery} / {imu}");
+        assert!(count(Kind::Reply) > 0.0);
+        // Each stream's count runs on by one.
+        for stream in Stream::ALL {
+            let seqs: Vec<u8> = frames
+                .iter()
+                .filter(|f| f.frame.kind() == Kind::Telemetry(stream))
+                .filter_map(|f| f.frame.seq())
+                .collect();
+            assert!(seqs.windows(2).all(|w| w[1] == w[0].wrapping_add(1)));
+        }
+        // Payloads are full of false headers, as the spec warns.
+        let starts: std::collections::HashSet<usize> = frames.iter().map(|f| f.start).collect();
+        let false_headers = bytes
+            .windows(2)
+            .enumerate()
+            .filter(|(i, w)| w[0] == 0xFF && (0xFA..=0xFC).contains(&w[1]) && !starts.contains(i))
+            .count();
+        // "About a tenth of all 16-bit values look like a header" (PROTOCOL.md, B).
+        assert!(
+            false_headers as f64 > 0.4 * imu,
+            "{false_headers} false headers in {imu} IMU frames"
+        );
+    }
+
+    #[test]
+    fn same_seed_same_bytes() {
+        assert_eq!(
+            BoardStream::new(7, 1.0).take(500),
+            BoardStream::new(7, 1.0).take(500)
+        );
+        assert_ne!(
+            BoardStream::new(7, 1.0).take(500).0,
+            BoardStream::new(8, 1.0).take(500).0
+        );
+    }
+}

@@ -1,0 +1,183 @@
+//! Scoring a downlink parser against what was sent through a channel.
+//!
+//! * A frame is **recalled** when the channel left it untouched and the parser emitted it, equal,
+//!   at its place.
+//! * An emitted frame is **false** when it does not start where a sent frame of its kind
+//!   started. (A frame the channel damaged, emitted at its own place, is *damaged*, not false:
+//!   without a checksum nobody can tell.)
+//! * **Latency** is how many bytes after a frame's last byte the parser emitted it.
+
+use crate::board::SentFrame;
+use crate::channel::Received;
+use chassis_protocol::{DownlinkParser, DownlinkStats, Lock, Telemetry};
+use std::collections::HashMap;
+
+/// The figures of one run.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Score {
+    /// Frames sent.
+    pub sent: usize,
+    /// Frames the channel left untouched.
+    pub untouched: usize,
+    /// Untouched frames emitted equal at their place.
+    pub recalled: usize,
+    /// Emitted frames that start where no sent frame of their kind started.
+    pub false_frames: usize,
+    /// Damaged frames emitted at their place.
+    pub damaged: usize,
+    /// Error events in the channel.
+    pub errors: usize,
+    /// Sum of the latencies of recalled frames, in bytes.
+    pub latency_sum: usize,
+    /// Largest latency of a recalled frame, in bytes.
+    pub latency_max: usize,
+    /// Recalled frames emitted on their last byte while the parser was Locked.
+    pub on_time_locked: usize,
+    /// Recalled frames whose last byte arrived while the parser was Locked.
+    pub recalled_locked: usize,
+    /// The parser's own counters at the end.
+    pub stats: DownlinkStats,
+}
+
+impl Score {
+    /// Share of untouched frames recalled.
+    pub fn recall(&self) -> f64 {
+        if self.untouched == 0 {
+            1.0
+        } else {
+            self.recalled as f64 / self.untouched as f64
+        }
+    }
+
+    /// False frames per million frames sent.
+    pub fn false_per_million(&self) -> f64 {
+        self.false_frames as f64 * 1e6 / self.sent.max(1) as f64
+    }
+
+    /// Untouched frames lost per channel error.
+    pub fn lost_per_error(&self) -> f64 {
+        (self.untouched - self.recalled) as f64 / self.errors.max(1) as f64
+    }
+
+    /// Mean latency of recalled frames, in bytes.
+    pub fn mean_latency(&self) -> f64 {
+        self.latency_sum as f64 / self.recalled.max(1) as f64
+    }
+
+    /// Adds another run's figures.
+    pub fn add(&mut self, other: &Score) {
+        self.sent += other.sent;
+        self.untouched += other.untouched;
+        self.recalled += other.recalled;
+        self.false_frames += other.false_frames;
+        self.damaged += other.damaged;
+        self.errors += other.errors;
+        self.latency_sum += other.latency_sum;
+        self.latency_max = self.latency_max.max(other.latency_max);
+        self.on_time_locked += other.on_time_locked;
+        self.recalled_locked += other.recalled_locked;
+    }
+}
+
+/// Runs `rx` through a new downlink parser, one byte at a time, then tells it the line went
+/// quiet, and scores what it emits against `sent`.
+pub fn score_downlink(sent: &[SentFrame], rx: &Received) -> Score {
+    let by_start: HashMap<usize, usize> =
+        sent.iter().enumerate().map(|(i, f)| (f.start, i)).collect();
+    let mut emitted_at = vec![false; sent.len()];
+    let mut score = Score {
+        sent: sent.len(),
+        errors: rx.errors,
+        ..Score::default()
+    };
+    let mut parser = DownlinkParser::new();
+
+    let mut judge = |frame: Telemetry, end: usize, now: usize, locked: bool, score: &mut Score| {
+        let len = frame.encode().len();
+        let start = (end + 1).saturating_sub(len);
+        let place = rx
+            .origin
+            .get(start)
+            .copied()
+            .flatten()
+            .and_then(|s| by_start.get(&s).copied());
+        match place {
+            Some(i) if sent[i].frame.kind() == frame.kind() => {
+                let original = &sent[i];
+                if rx.untouched(original.start, original.end())
+                    && original.frame == frame
+                    && !emitted_at[i]
+                {
+                    emitted_at[i] = true;
+                    score.recalled += 1;
+                    let latency = now - end;
+                    score.latency_sum += latency;
+                    score.latency_max = score.latency_max.max(latency);
+                    if locked {
+                        score.recalled_locked += 1;
+                        score.on_time_locked += usize::from(latency == 0);
+                    }
+                } else {
+                    score.damaged += 1;
+                }
+            }
+            _ => score.false_frames += 1,
+        }
+    };
+
+    // Whether the parser was Locked when each received byte arrived.
+    let mut locked_at = Vec::with_capacity(rx.bytes.len());
+    for (now, byte) in rx.bytes.iter().enumerate() {
+        locked_at.push(parser.lock() == Lock::Locked);
+        if let Some(frame) = parser.push(*byte) {
+            let end = now - parser.buffered();
+            judge(frame, end, now, locked_at[end], &mut score);
+        }
+    }
+    let now = rx.bytes.len().saturating_sub(1);
+    while let Some(frame) = parser.idle() {
+        let end = now - parser.buffered();
+        judge(frame, end, now, locked_at[end], &mut score);
+    }
+    score.untouched = sent
+        .iter()
+        .filter(|f| rx.untouched(f.start, f.end()))
+        .count();
+    score.stats = *parser.stats();
+    score
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::board::BoardStream;
+    use crate::channel::{Noise, transmit};
+    use rand::SeedableRng;
+    use rand_pcg::Pcg64Mcg;
+
+    #[test]
+    fn a_clean_stream_is_recalled_whole_and_on_time_once_locked() {
+        let (bytes, sent) = BoardStream::new(3, 2.0).take(5_000);
+        let rx = transmit(&bytes, &Noise::default(), &mut Pcg64Mcg::seed_from_u64(0));
+        let score = score_downlink(&sent, &rx);
+        assert_eq!(score.untouched, 5_000);
+        assert_eq!(score.recalled, 5_000);
+        assert_eq!(score.false_frames, 0);
+        assert_eq!(score.damaged, 0);
+        // Replies holding a header and each stream's first frame wait two bytes; all else is on time.
+        assert!(
+            score.on_time_locked as f64 > 0.99 * score.recalled_locked as f64,
+            "{score:?}"
+        );
+    }
+
+    #[test]
+    fn a_noisy_stream_is_scored_against_the_channel() {
+        let (bytes, sent) = BoardStream::new(4, 2.0).take(20_000);
+        let rx = transmit(&bytes, &Noise::mixed(1e-3), &mut Pcg64Mcg::seed_from_u64(5));
+        let score = score_downlink(&sent, &rx);
+        assert!(score.errors > 100);
+        assert!(score.untouched < score.sent);
+        assert!(score.recall() > 0.99, "{score:?}");
+    }
+}
