@@ -1,0 +1,169 @@
+//! The workspace's tasks, run with `cargo xtask <task>` (an alias in `.cargo/config.toml`).
+//!
+//! | task | what it does |
+//! |---|---|
+//! | `demo` | the main job: today a host demo (frames built, a noisy board stream parsed) |
+//! | `test` | everything CI checks: format, lints, tests, docs, `no_std` builds for Cortex-M |
+//! | `sweep` | the full noise sweep of the downlink parser (about a minute; not part of `test`) |
+//!
+//! Each task installs what it needs (rustup targets) before it runs, so a fresh machine with
+//! rustup and cargo needs nothing else.
+
+use std::process::{Command, ExitCode};
+
+/// Thumb targets the protocol crate must build for: Cortex-M0+ and Cortex-M4F.
+const THUMB_TARGETS: [&str; 2] = ["thumbv6m-none-eabi", "thumbv7em-none-eabihf"];
+
+fn main() -> ExitCode {
+    let task = std::env::args().nth(1).unwrap_or_default();
+    let result = match task.as_str() {
+        "demo" => demo(),
+        "test" => test(),
+        "sweep" => sweep(),
+        _ => {
+            eprintln!("usage: cargo xtask <demo | test | sweep>");
+            return ExitCode::from(2);
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("xtask {task}: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Runs a command, echoing it; an error names the command if it fails.
+fn run(program: &str, args: &[&str]) -> Result<(), String> {
+    run_with(program, args, &[])
+}
+
+/// [`run`], with extra environment variables for the command.
+fn run_with(program: &str, args: &[&str], env: &[(&str, &str)]) -> Result<(), String> {
+    let name = std::path::Path::new(program)
+        .file_name()
+        .map_or_else(|| program.into(), |n| n.to_string_lossy());
+    eprintln!("$ {name} {}", args.join(" "));
+    let status = Command::new(program)
+        .args(args)
+        .envs(env.iter().copied())
+        .status()
+        .map_err(|e| format!("could not start {program}: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("`{program} {}` failed ({status})", args.join(" ")))
+    }
+}
+
+/// The cargo that runs this task.
+fn cargo_program() -> String {
+    std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string())
+}
+
+fn cargo(args: &[&str]) -> Result<(), String> {
+    run(&cargo_program(), args)
+}
+
+/// Adds the rustup targets that are not installed yet.
+fn install_targets(targets: &[&str]) -> Result<(), String> {
+    let installed = Command::new("rustup")
+        .args(["target", "list", "--installed"])
+        .output()
+        .map_err(|e| format!("rustup is needed to add {targets:?}: {e}"))?;
+    let installed = String::from_utf8_lossy(&installed.stdout);
+    let missing: Vec<&str> = targets
+        .iter()
+        .copied()
+        .filter(|t| !installed.lines().any(|line| line.trim() == *t))
+        .collect();
+    if missing.is_empty() {
+        return Ok(());
+    }
+    let mut args = vec!["target", "add"];
+    args.extend(missing);
+    run("rustup", &args)
+}
+
+fn demo() -> Result<(), String> {
+    cargo(&[
+        "run",
+        "--release",
+        "--quiet",
+        "-p",
+        "chassis-host-tests",
+        "--example",
+        "demo",
+    ])
+}
+
+fn sweep() -> Result<(), String> {
+    cargo(&[
+        "run",
+        "--release",
+        "--quiet",
+        "-p",
+        "chassis-host-tests",
+        "--bin",
+        "noise-sweep",
+    ])
+}
+
+fn test() -> Result<(), String> {
+    install_targets(&THUMB_TARGETS)?;
+    cargo(&["fmt", "--all", "--check"])?;
+    cargo(&[
+        "clippy",
+        "--workspace",
+        "--all-targets",
+        "--",
+        "-D",
+        "warnings",
+    ])?;
+    cargo(&[
+        "clippy",
+        "-p",
+        "chassis-protocol",
+        "--all-targets",
+        "--all-features",
+        "--",
+        "-D",
+        "warnings",
+    ])?;
+    cargo(&["test", "--workspace"])?;
+    cargo(&["test", "-p", "chassis-protocol", "--all-features"])?;
+    for target in THUMB_TARGETS {
+        cargo(&[
+            "build",
+            "-p",
+            "chassis-protocol",
+            "--release",
+            "--target",
+            target,
+        ])?;
+        cargo(&[
+            "build",
+            "-p",
+            "chassis-protocol",
+            "--release",
+            "--target",
+            target,
+            "--features",
+            "defmt,serde",
+        ])?;
+    }
+    // Every public item documented, every intra-doc link resolved.
+    run_with(
+        &cargo_program(),
+        &[
+            "doc",
+            "-p",
+            "chassis-protocol",
+            "--no-deps",
+            "--all-features",
+        ],
+        &[("RUSTDOCFLAGS", "-D warnings")],
+    )?;
+    Ok(())
+}
