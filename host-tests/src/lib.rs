@@ -10,4 +10,4 @@ pub mod score;
 
 pub use board::{BoardStream, SentFrame};
 pub use channel::{Noise, Received};
-pub use score::{Score, score_downlink};
+pub use score::{Score, Startup, score_downlink, startup};

@@ -147,6 +147,48 @@ pub fn score_downlink(sent: &[SentFrame], rx: &Received) -> Score {
     score
 }
 
+/// What starting to listen in the middle of a clean stream costs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Startup {
+    /// Start offsets tried.
+    pub starts: usize,
+    /// Starts after which every frame following the first complete one came out.
+    pub all_after_first: usize,
+    /// Most frames after the first complete one lost by any start.
+    pub worst_lost: usize,
+    /// Starts that emitted at least one false frame.
+    pub with_false: usize,
+    /// False frames emitted, in all.
+    pub false_frames: usize,
+}
+
+/// Starts a new parser at every offset of the first three frames of `seeds` clean streams of
+/// `frames` frames, and counts what the starts cost.
+pub fn startup(seeds: std::ops::Range<u64>, frames: usize) -> Startup {
+    let mut figures = Startup::default();
+    for seed in seeds {
+        let (bytes, sent) = crate::BoardStream::new(seed, 2.0).take(frames.max(4));
+        for offset in 0..sent[3].start {
+            let first = sent
+                .iter()
+                .position(|f| f.start >= offset)
+                .unwrap_or(sent.len());
+            let mut parser = DownlinkParser::new();
+            let mut out: Vec<Telemetry> = parser.frames(&bytes[offset..]).collect();
+            out.extend(std::iter::from_fn(|| parser.idle()));
+            let expected: Vec<Telemetry> = sent[first..].iter().map(|f| f.frame).collect();
+            let false_frames = out.iter().filter(|f| !expected.contains(f)).count();
+            let lost = expected.iter().skip(1).filter(|f| !out.contains(f)).count();
+            figures.starts += 1;
+            figures.all_after_first += usize::from(lost == 0);
+            figures.worst_lost = figures.worst_lost.max(lost);
+            figures.with_false += usize::from(false_frames > 0);
+            figures.false_frames += false_frames;
+        }
+    }
+    figures
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -32,6 +32,10 @@
 //! | [`telemetry`] | board → master: [`Imu`], [`Encoders`], [`Battery`], [`Reply`] |
 //! | [`parse`] | [`DownlinkParser`] (board → master), [`UplinkParser`] (master → board), their counters |
 //!
+//! There is no checksum in this protocol, and a gyro at rest writes false headers into every
+//! other IMU payload: how the board → master parser resynchronises, and the trade-off it makes
+//! between latency and false frames, is documented in [`parse::downlink`].
+//!
 //! Each frame type has `LEN`, `encode() -> [u8; LEN]` and `decode(&[u8]) -> Result<_, Error>`;
 //! every decoded frame encodes back to the same bytes (reserved bits and unknown codes are kept).
 //! Signed values are signed in the API; magnitudes and direction bits exist only on the wire.

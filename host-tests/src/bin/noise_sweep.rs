@@ -9,7 +9,7 @@
 //! frames lost per channel error, latency, and the parser's own counters.
 
 use chassis_host_tests::channel::{Noise, transmit};
-use chassis_host_tests::{BoardStream, Score, score_downlink};
+use chassis_host_tests::{BoardStream, Score, score_downlink, startup};
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use std::process::ExitCode;
@@ -113,5 +113,22 @@ fn main() -> ExitCode {
             s.latency_max,
         );
     }
+    let seeds = 500;
+    let s = startup(0..seeds, 40);
+    println!(
+        "\nStarting to listen mid-stream (clean line, every offset in the first three frames, {seeds} streams):\n"
+    );
+    println!(
+        "| starts | every frame after the first complete one | worst frames lost after it | starts with a false frame | false frames |"
+    );
+    println!("|---|---|---|---|---|");
+    println!(
+        "| {} | {:.2} % | {} | {:.2} % | {} |",
+        s.starts,
+        s.all_after_first as f64 * 100.0 / s.starts as f64,
+        s.worst_lost,
+        s.with_false as f64 * 100.0 / s.starts as f64,
+        s.false_frames
+    );
     ExitCode::SUCCESS
 }

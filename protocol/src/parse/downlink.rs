@@ -45,7 +45,7 @@
 //!
 //! | state | on its last byte | two bytes later, if they are a header (or the line is quiet) | otherwise |
 //! |---|---|---|---|
-//! | Hunting | — | count continues, near or provisional; a reply holding no header in its value; a stream's first frame while no count is trusted | reject |
+//! | Hunting | — | count continues or is near (also a provisional count, or any count while none is trusted); a reply holding no header in its value; an IMU or encoder stream's first frame while no count is trusted | reject |
 //! | Tentative | count continues; a reply holding no header | anything but a far count (at most PROBATION_FRAMES in a row without a count that continues) | reject |
 //! | Locked | count continues; a reply holding no header | anything; a far count only right after a frame whose count continued | reject |
 //!
@@ -58,8 +58,9 @@
 //! * After [`FORGET_AFTER`] bytes without a single frame that continues its count, every count is
 //!   forgotten (the board may have restarted; a false alignment may have taught a false count).
 //!   That bounds how long anything can hold the parser off: it can never stay stuck.
-//! * A reply whose value bytes hold `FF FA`..`FF FC`, or end in `FF` or `23`, could be a
-//!   truncated reply with the next frame's start in it: it waits for the next header.
+//! * A reply whose value bytes hold `FF FA`..`FF FC` could be a truncated reply with the next
+//!   frame's start in it: it waits for the next header (or a quiet line), and while hunting it is
+//!   taken only when the line goes quiet right after it.
 //!
 //! # The trade-off chosen
 //!
@@ -131,6 +132,7 @@ pub enum Lock {
 
 /// The parsing state proper, counters excluded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 struct State {
     /// Bytes from the first byte of the candidate being judged.
     window: Window<WINDOW>,
@@ -209,6 +211,7 @@ enum Continuity {
 /// assert_eq!(parser.stats().discarded, 1);
 /// ```
 #[derive(Clone, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct DownlinkParser {
     state: State,
     stats: DownlinkStats,
@@ -384,7 +387,9 @@ impl DownlinkParser {
             if state.since_confirmed >= FORGET_AFTER {
                 state.seen = 0;
                 state.provisional = 0;
-                state.since_confirmed = 0;
+                // Keep the bytes past the mark, so that bytes fed one at a time and in a slice
+                // leave the same state.
+                state.since_confirmed = state.since_confirmed.saturating_sub(FORGET_AFTER);
             }
         }
     }
@@ -480,7 +485,10 @@ impl DownlinkParser {
         };
         let continuity = self.continuity(&frame);
         // A truncated reply would hold the next frame's header in its value bytes.
-        let clean_reply = !holds_a_frame_start(bytes.get(2..).unwrap_or(&[]));
+        // A truncated reply would hold the next frame's start in its value bytes, and bytes
+        // after its end; one that ends as the line goes quiet is whole.
+        let quiet_fit = idle && buf.len() == len;
+        let clean_reply = !holds_a_frame_start(bytes.get(2..).unwrap_or(&[])) || quiet_fit;
         let aligned = state.lock != Lock::Hunting;
 
         // On the frame's last byte, when the evidence is already there.
@@ -505,12 +513,21 @@ impl DownlinkParser {
         let plausible = match state.lock {
             Lock::Hunting => match continuity {
                 Continuity::Continues | Continuity::Near => true,
-                // A count learnt in a hunt may be false, but it is the best guess there is.
-                Continuity::Provisional => self.provisional_near(&frame),
+                // A count learnt in a hunt may be false, but it is the best guess there is;
+                // while no count is trusted at all (start-up), it is no evidence.
+                Continuity::Provisional => {
+                    state.seen & !state.provisional == 0 || self.provisional_near(&frame)
+                }
                 // Could be a frame's tail and the next frame's start: the driver asks again.
                 Continuity::Reply => clean_reply,
-                // A stream's first frame: proof enough only while no count is trusted yet.
-                Continuity::Unknown => state.seen & !state.provisional == 0,
+                // A stream's first frame: proof enough only while no count is trusted yet, and
+                // not for the battery: a false `FF FC` is as common as a false `FF FA`, and a
+                // real battery frame a hundred times rarer than an IMU frame.
+                // (A battery frame that the line's going quiet delimits exactly is taken.)
+                Continuity::Unknown => {
+                    state.seen & !state.provisional == 0
+                        && (frame.kind() != Kind::Telemetry(Stream::Battery) || quiet_fit)
+                }
                 Continuity::Far => false,
             },
             Lock::Tentative => {
@@ -582,11 +599,11 @@ impl DownlinkParser {
     }
 }
 
-/// Whether `bytes` hold what could be the start of the next frame: `FF FA`..`FF FC`, or a
-/// last byte `FF` or `23`.
+/// Whether `bytes` (a reply's value) hold a telemetry header, `FF FA`..`FF FC`: then the reply
+/// may be a truncated one with the next frame's start in it. (A truncated reply whose last byte
+/// is the next frame's `FF` is caught anyway: the two bytes after it, `FA`.., are no header.)
 fn holds_a_frame_start(bytes: &[u8]) -> bool {
-    let pair = bytes.windows(2).any(|w| matches!(w, [0xFF, 0xFA..=0xFC]));
-    pair || matches!(bytes.last(), Some(&b) if Kind::may_start(b))
+    bytes.windows(2).any(|w| matches!(w, [0xFF, 0xFA..=0xFC]))
 }
 
 /// A count jump on a confirmed alignment, right after a frame whose count continued: most likely
@@ -637,6 +654,7 @@ fn record_seq(
 
 /// Iterator over the frames of a byte slice: see [`DownlinkParser::frames`].
 #[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Frames<'p, 'b> {
     parser: &'p mut DownlinkParser,
     rest: &'b [u8],

@@ -41,6 +41,7 @@ const SETTINGS_FIXED_AT: usize = 3;
 /// assert_eq!(parser.stats().discarded, 2);
 /// ```
 #[derive(Clone, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct UplinkParser {
     window: Window<{ command::MAX_LEN }>,
     /// Bytes were thrown away since the last frame.
@@ -208,6 +209,7 @@ impl UplinkParser {
 
 /// Iterator over the commands of a byte slice: see [`UplinkParser::frames`].
 #[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct UplinkFrames<'p, 'b> {
     parser: &'p mut UplinkParser,
     rest: &'b [u8],

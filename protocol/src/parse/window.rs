@@ -6,6 +6,7 @@
 /// Rejecting a candidate drops exactly one byte (the candidate's first), so the parser rescans
 /// from the byte after it; accepting a frame drops the frame's bytes. Nothing here can panic.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub(crate) struct Window<const N: usize> {
     bytes: [u8; N],
     len: u8,
