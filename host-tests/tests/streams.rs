@@ -267,12 +267,12 @@ const START_BOUND: usize = 4;
 /// "count" is accel X's low byte continues its count like a real one.)
 const START_BOUND_BYTES: usize = chassis_protocol::parse::downlink::FORGET_AFTER as usize
     + 2 * chassis_protocol::telemetry::MAX_LEN;
-/// After a truncated telemetry frame, every frame from the fourth after it on, and nothing false.
-const TRUNCATION_BOUND: usize = 3;
-/// After a truncated reply, from the sixth: a reply cut short right before a frame whose payload
+/// After a truncated telemetry frame, every frame from the sixth after it on, and nothing false.
+const TRUNCATION_BOUND: usize = 5;
+/// After a truncated reply, from the seventh: a reply cut short right before a frame whose payload
 /// holds a false header reads as a whole reply (its value holds the next frame's start, which a
 /// real reply's value may too), and the alignment it leaves is false until the counts say so.
-const TRUNCATED_REPLY_BOUND: usize = 5;
+const TRUNCATED_REPLY_BOUND: usize = 6;
 
 #[test]
 fn starting_at_any_offset_recovers_within_a_bound() {

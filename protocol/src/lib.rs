@@ -52,6 +52,7 @@
 //! * `defmt`: `defmt::Format` for every public type.
 //! * `serde`: `Serialize` / `Deserialize` for the typed frames and counters.
 //! * `std`: links `std` (nothing needs it yet).
+//! * `arbitrary`: `arbitrary::Arbitrary` for the frames, for fuzzing (values `decode` can return).
 
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
@@ -68,6 +69,8 @@
     )
 )]
 
+#[cfg(feature = "arbitrary")]
+mod arbitrary;
 mod bytes;
 pub mod command;
 mod error;

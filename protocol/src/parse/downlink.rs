@@ -47,7 +47,7 @@
 //! |---|---|---|---|
 //! | Hunting | — | count continues or is near (also a provisional count, or any count while none is trusted); a reply holding no header in its value; an IMU or encoder stream's first frame while no count is trusted | reject |
 //! | Tentative | count continues; a reply holding no header | anything but a far count (at most PROBATION_FRAMES in a row without a count that continues) | reject |
-//! | Locked | count continues; a reply holding no header | anything; a far count only right after a frame whose count continued | reject |
+//! | Locked | count continues; a reply holding no header | count near, a reply; a far, provisional or first count only right after a frame whose count continued | reject |
 //!
 //! * A rejected candidate costs exactly **one** byte: its first. Scanning starts again at the
 //!   byte after it, over the bytes already in the window, so a real frame that a false candidate
@@ -130,6 +130,9 @@ pub enum Lock {
     Locked,
 }
 
+/// `State::jump_stream` when there is no jump to remember.
+const NO_JUMP: u8 = u8::MAX;
+
 /// The parsing state proper, counters excluded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -145,8 +148,13 @@ struct State {
     provisional: u8,
     /// The last count of each stream.
     last_seq: [u8; 3],
-    /// The last count jump taken on a confirmed alignment: (stream index, count received).
-    jump: Option<(u8, u8)>,
+    /// The last count jump taken on a confirmed alignment: the stream's index (`NO_JUMP` if
+    /// none) and the count received.
+    jump_stream: u8,
+    jump_seq: u8,
+    /// The last frame was taken on weak evidence (a count jump, a hunt): the boundary after it
+    /// is not certain.
+    weak: bool,
     /// While Tentative: frames so far whose count continued their stream.
     confirms: u8,
     /// Frames accepted since the last one that continued its count (saturating).
@@ -235,7 +243,9 @@ impl DownlinkParser {
                 seen: 0,
                 provisional: 0,
                 last_seq: [0; 3],
-                jump: None,
+                jump_stream: NO_JUMP,
+                jump_seq: 0,
+                weak: false,
                 confirms: 0,
                 since_continued: 0,
                 drain: false,
@@ -264,20 +274,28 @@ impl DownlinkParser {
     }
 
     /// Feeds bytes until a frame comes out; returns it and the bytes not yet consumed. Call
-    /// again with the rest until it returns `(None, [])`. Emits exactly the frames that feeding
-    /// the same bytes one at a time through [`push`](DownlinkParser::push) would, in the same
-    /// order, and copies a frame's body in one step where it can.
+    /// again with the rest until it returns `(None, [])` (with an empty slice it emits a frame
+    /// still ready in the window, as [`poll`](DownlinkParser::poll) does). It goes through the
+    /// same states as feeding the same bytes one at a time through
+    /// [`push`](DownlinkParser::push), so it emits the same frames in the same order; it only
+    /// copies a frame's body in one step where no decision can fall in between.
     pub fn push_slice<'a>(&mut self, mut bytes: &'a [u8]) -> (Option<Telemetry>, &'a [u8]) {
-        if self.state.drain {
-            if let Some(frame) = self.poll() {
-                return (Some(frame), bytes);
-            }
+        if bytes.is_empty() && self.state.drain {
+            return (self.poll(), bytes);
         }
-        while !bytes.is_empty() {
+        while let Some((&first, rest)) = bytes.split_first() {
+            if self.state.drain {
+                // Exactly as `push` does it, so both paths go through the same states.
+                bytes = rest;
+                if let Some(frame) = self.push(first) {
+                    return (Some(frame), bytes);
+                }
+                continue;
+            }
             let step = self.bytes_before_decision().clamp(1, bytes.len());
-            let (now, rest) = bytes.split_at_checked(step).unwrap_or((bytes, &[]));
+            let (now, later) = bytes.split_at_checked(step).unwrap_or((bytes, &[]));
             self.append(now);
-            bytes = rest;
+            bytes = later;
             if let Some(frame) = self.poll() {
                 return (Some(frame), bytes);
             }
@@ -533,11 +551,16 @@ impl DownlinkParser {
             Lock::Tentative => {
                 state.since_continued < PROBATION_FRAMES && continuity != Continuity::Far
             }
-            // A count jump on a confirmed alignment is taken (its count stays provisional) when
-            // the frame before continued its count: then this boundary is certain, and the jump
-            // is most likely a damaged count byte. After a frame that was taken on weaker
-            // evidence, the boundary itself is in doubt.
-            Lock::Locked => continuity != Continuity::Far || state.since_continued == 0,
+            // On a confirmed alignment, a frame whose count says nothing (a stream's first
+            // frame, a provisional count) or jumps is taken when the frame before was taken on
+            // good evidence: then this boundary is certain (and a jump is most likely a damaged
+            // count byte). After a frame taken on weak evidence, the boundary is in doubt.
+            Lock::Locked => match continuity {
+                Continuity::Unknown | Continuity::Provisional | Continuity::Far => {
+                    !state.weak || quiet_fit
+                }
+                Continuity::Continues | Continuity::Near | Continuity::Reply => true,
+            },
         };
         if followed && plausible {
             Verdict::Accept(frame, len)
@@ -568,6 +591,14 @@ impl DownlinkParser {
             0
         } else {
             state.since_continued.saturating_add(1)
+        };
+        state.weak = match continuity {
+            _ if state.lock == Lock::Hunting => true,
+            Continuity::Continues | Continuity::Near => false,
+            Continuity::Far => true,
+            // A reply (taken with the next header as proof when its value holds one), a
+            // stream's first frame, a provisional count: as good a boundary as the frame before.
+            Continuity::Reply | Continuity::Unknown | Continuity::Provisional => state.weak,
         };
         match state.lock {
             Lock::Hunting => {
@@ -615,13 +646,14 @@ fn record_jump(state: &mut State, stats: &mut DownlinkStats, stream: Stream, seq
     let Some(last) = state.last_seq.get_mut(i) else {
         return;
     };
-    let again = state.jump == Some((i as u8, seq.wrapping_sub(1)));
+    let again = usize::from(state.jump_stream) == i && state.jump_seq == seq.wrapping_sub(1);
     if again {
-        state.jump = None;
+        state.jump_stream = NO_JUMP;
         record_seq(state, stats, stream, seq, true);
     } else {
         *last = last.wrapping_add(1);
-        state.jump = u8::try_from(i).ok().map(|i| (i, seq));
+        state.jump_stream = u8::try_from(i).unwrap_or(NO_JUMP);
+        state.jump_seq = seq;
     }
 }
 
