@@ -3,11 +3,12 @@
 //! | task | what it does |
 //! |---|---|
 //! | `demo` | the main job: today a host demo (frames built, a noisy board stream parsed) |
-//! | `test` | everything CI checks: format, lints, tests, docs, `no_std` builds for Cortex-M |
+//! | `test` | everything CI checks: format, lints, tests, docs, `no_std` builds for Cortex-M, and a short run of every fuzz target |
+//! | `fuzz [SECONDS]` | only the fuzz targets, each for SECONDS (default 30) |
 //! | `sweep` | the full noise sweep of the downlink parser (about a minute; not part of `test`) |
 //!
-//! Each task installs what it needs (rustup targets) before it runs, so a fresh machine with
-//! rustup and cargo needs nothing else.
+//! Each task installs what it needs (rustup targets, the nightly toolchain and cargo-fuzz)
+//! before it runs, so a fresh machine with rustup and cargo needs nothing else.
 
 use std::process::{Command, ExitCode};
 
@@ -20,8 +21,17 @@ fn main() -> ExitCode {
         "demo" => demo(),
         "test" => test(),
         "sweep" => sweep(),
+        "fuzz" => {
+            let seconds = std::env::args().nth(2).unwrap_or_else(|| "30".to_string());
+            match seconds.parse::<u32>() {
+                Ok(s) if s > 0 => fuzz(s),
+                _ => Err(format!(
+                    "fuzz takes a number of seconds per target, not {seconds:?}"
+                )),
+            }
+        }
         _ => {
-            eprintln!("usage: cargo xtask <demo | test | sweep>");
+            eprintln!("usage: cargo xtask <demo | test | sweep | fuzz [SECONDS]>");
             return ExitCode::from(2);
         }
     };
@@ -165,5 +175,92 @@ fn test() -> Result<(), String> {
         ],
         &[("RUSTDOCFLAGS", "-D warnings")],
     )?;
+    fuzz(30)
+}
+
+/// The fuzz targets, in `host-tests/fuzz`.
+const FUZZ_TARGETS: [&str; 4] = ["downlink", "uplink", "roundtrip", "spliced"];
+
+/// Runs every fuzz target for `seconds`, from generated seed corpora; fails on any crash.
+fn fuzz(seconds: u32) -> Result<(), String> {
+    install_nightly()?;
+    install_cargo_fuzz()?;
+    let root = workspace_root()?;
+    let fuzz_dir = root.join("host-tests").join("fuzz");
+    let corpus = fuzz_dir.join("corpus");
+    let corpus_arg = corpus.to_string_lossy().into_owned();
+    cargo(&[
+        "run",
+        "--release",
+        "--quiet",
+        "-p",
+        "chassis-host-tests",
+        "--bin",
+        "fuzz-seeds",
+        "--",
+        &corpus_arg,
+    ])?;
+    let max_time = format!("-max_total_time={seconds}");
+    for target in FUZZ_TARGETS {
+        let target_corpus = corpus.join(target).to_string_lossy().into_owned();
+        let status = Command::new("cargo")
+            .args([
+                "+nightly",
+                "fuzz",
+                "run",
+                target,
+                &target_corpus,
+                "--",
+                &max_time,
+            ])
+            .current_dir(&fuzz_dir)
+            .status()
+            .map_err(|e| format!("could not start cargo fuzz: {e}"))?;
+        if !status.success() {
+            return Err(format!(
+                "fuzz target {target} failed ({status}): see host-tests/fuzz/artifacts/{target}"
+            ));
+        }
+    }
     Ok(())
+}
+
+/// The workspace root: the parent of this crate's directory.
+fn workspace_root() -> Result<std::path::PathBuf, String> {
+    let manifest =
+        std::env::var("CARGO_MANIFEST_DIR").map_err(|_| "run me with cargo xtask".to_string())?;
+    std::path::Path::new(&manifest)
+        .parent()
+        .map(std::path::Path::to_path_buf)
+        .ok_or_else(|| "no workspace root above xtask".to_string())
+}
+
+/// Installs the nightly toolchain (minimal profile) if it is missing: cargo-fuzz needs it.
+fn install_nightly() -> Result<(), String> {
+    let toolchains = Command::new("rustup")
+        .args(["toolchain", "list"])
+        .output()
+        .map_err(|e| format!("rustup is needed to install nightly: {e}"))?;
+    if String::from_utf8_lossy(&toolchains.stdout)
+        .lines()
+        .any(|l| l.starts_with("nightly"))
+    {
+        return Ok(());
+    }
+    run(
+        "rustup",
+        &["toolchain", "install", "nightly", "--profile", "minimal"],
+    )
+}
+
+/// Installs cargo-fuzz if `cargo fuzz` is not there.
+fn install_cargo_fuzz() -> Result<(), String> {
+    let present = Command::new("cargo")
+        .args(["fuzz", "--version"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if present {
+        return Ok(());
+    }
+    cargo(&["install", "--locked", "cargo-fuzz"])
 }
