@@ -11,3 +11,22 @@ pub mod score;
 pub use board::{BoardStream, SentFrame};
 pub use channel::{Noise, Received};
 pub use score::{Score, Startup, score_downlink, startup};
+
+/// Cuts `bytes` into consecutive pieces whose lengths are taken from `lengths` in turn (each at
+/// least 1; the whole rest at once if `lengths` is empty): the reads a UART driver might see.
+pub fn pieces<'a>(bytes: &'a [u8], lengths: &'a [usize]) -> impl Iterator<Item = &'a [u8]> + 'a {
+    let mut rest = bytes;
+    let mut lengths = lengths.iter().cycle();
+    std::iter::from_fn(move || {
+        if rest.is_empty() {
+            return None;
+        }
+        let n = lengths
+            .next()
+            .map_or(rest.len(), |n| (*n).max(1))
+            .min(rest.len());
+        let (piece, later) = rest.split_at(n);
+        rest = later;
+        Some(piece)
+    })
+}

@@ -2,8 +2,8 @@
 //! parsers, and the downlink parser against a deliberately simple reference parser on clean
 //! streams.
 
-use chassis_host_tests::BoardStream;
 use chassis_host_tests::channel::{Noise, transmit};
+use chassis_host_tests::{BoardStream, pieces};
 use chassis_protocol::parse::downlink::FORGET_AFTER;
 use chassis_protocol::{
     Action, Battery, Command, DownlinkParser, Encoders, Imu, Kind, Motors, Register, Reply,
@@ -163,14 +163,8 @@ proptest! {
 
         let mut chunked = DownlinkParser::new();
         let mut got = Vec::new();
-        let mut rest = &rx.bytes[..];
-        for cut in cuts.iter().cycle() {
-            if rest.is_empty() {
-                break;
-            }
-            let (now, later) = rest.split_at((*cut).min(rest.len()));
-            got.extend(chunked.frames(now));
-            rest = later;
+        for piece in pieces(&rx.bytes, &cuts) {
+            got.extend(chunked.frames(piece));
         }
         got.extend(std::iter::from_fn(|| chunked.idle()));
         prop_assert_eq!(got, expected);
@@ -191,14 +185,8 @@ proptest! {
         let expected: Vec<Command> = bytes.iter().filter_map(|b| one.push(*b)).collect();
         let mut chunked = UplinkParser::new();
         let mut got = Vec::new();
-        let mut rest = &bytes[..];
-        for cut in cuts.iter().cycle() {
-            if rest.is_empty() {
-                break;
-            }
-            let (now, later) = rest.split_at((*cut).min(rest.len()));
-            got.extend(chunked.frames(now));
-            rest = later;
+        for piece in pieces(&bytes, &cuts) {
+            got.extend(chunked.frames(piece));
         }
         prop_assert_eq!(&got, &expected);
         // With no noise in front, every command comes out.

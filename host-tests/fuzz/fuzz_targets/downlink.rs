@@ -7,6 +7,7 @@
 //! spec defines); after `idle` nothing is left buffered.
 #![no_main]
 
+use chassis_host_tests::pieces;
 use chassis_protocol::{DownlinkParser, Register, Telemetry};
 use libfuzzer_sys::fuzz_target;
 
@@ -20,7 +21,10 @@ fn well_formed(frame: &Telemetry) {
 fn accounted(parser: &DownlinkParser, fed: usize, emitted: &[Telemetry]) {
     let in_frames: usize = emitted.iter().map(|f| f.encode().len()).sum();
     let stats = parser.stats();
-    assert_eq!(in_frames + stats.discarded as usize + parser.buffered(), fed);
+    assert_eq!(
+        in_frames + stats.discarded as usize + parser.buffered(),
+        fed
+    );
     assert!(parser.buffered() <= 17);
 }
 
@@ -39,20 +43,19 @@ fuzz_target!(|input: (Vec<u8>, Vec<u8>)| {
 
     let mut sliced = DownlinkParser::new();
     let mut by_slice = Vec::new();
-    let mut rest = &bytes[..];
-    let mut cut = cuts.iter().cycle();
-    while !rest.is_empty() {
-        let n = cut.next().map_or(rest.len(), |c| usize::from(*c).max(1)).min(rest.len());
-        let (now, later) = rest.split_at(n);
-        by_slice.extend(sliced.frames(now));
-        rest = later;
+    let cuts: Vec<usize> = cuts.iter().map(|c| usize::from(*c)).collect();
+    for piece in pieces(&bytes, &cuts) {
+        by_slice.extend(sliced.frames(piece));
     }
     // A frame may be ready in the window after the last byte: `poll` drains it on both.
     by_byte.extend(std::iter::from_fn(|| one.poll()));
     by_slice.extend(std::iter::from_fn(|| sliced.poll()));
     assert_eq!(by_slice, by_byte);
     assert_eq!(sliced.stats(), one.stats());
-    assert_eq!((sliced.lock(), sliced.buffered()), (one.lock(), one.buffered()));
+    assert_eq!(
+        (sliced.lock(), sliced.buffered()),
+        (one.lock(), one.buffered())
+    );
 
     while let Some(frame) = one.idle() {
         well_formed(&frame);

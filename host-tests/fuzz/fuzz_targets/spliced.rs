@@ -40,17 +40,28 @@ fuzz_target!(|input: (u64, u16, u8, Vec<u8>)| {
     }
 
     let bound = shift(resume) + RECOVERY_BYTES;
-    let after: Vec<_> = sent.iter().filter(|f| f.start >= resume && shift(f.start) >= bound).collect();
-    let Some(first_after) = after.first() else { return };
+    let after: Vec<_> = sent
+        .iter()
+        .filter(|f| f.start >= resume && shift(f.start) >= bound)
+        .collect();
+    let Some(first_after) = after.first() else {
+        return;
+    };
     for f in &after {
         assert!(out.iter().any(|(_, o)| *o == f.frame), "lost {:?}", f.frame);
     }
     // Nothing false from the first frame after the bound on (found by where it ended, since
     // two replies can be equal).
     let first_end = shift(first_after.start) + first_after.frame.encode().len() - 1;
-    let from = out.iter().position(|(i, _)| *i >= first_end).unwrap_or(out.len());
+    let from = out
+        .iter()
+        .position(|(i, _)| *i >= first_end)
+        .unwrap_or(out.len());
     for (_, frame) in &out[from..] {
-        assert!(after.iter().any(|f| f.frame == *frame), "false frame {frame:?}");
+        assert!(
+            after.iter().any(|f| f.frame == *frame),
+            "false frame {frame:?}"
+        );
     }
     assert_eq!(parser.lock(), Lock::Locked);
 });

@@ -2,12 +2,16 @@
 //! same frames, every byte accounted for, every command well formed.
 #![no_main]
 
+use chassis_host_tests::pieces;
 use chassis_protocol::{Command, UplinkParser};
 use libfuzzer_sys::fuzz_target;
 
 fn accounted(parser: &UplinkParser, fed: usize, emitted: &[Command]) {
     let in_frames: usize = emitted.iter().map(Command::len).sum();
-    assert_eq!(in_frames + parser.stats().discarded as usize + parser.buffered(), fed);
+    assert_eq!(
+        in_frames + parser.stats().discarded as usize + parser.buffered(),
+        fed
+    );
     assert!(parser.buffered() <= 12);
 }
 
@@ -26,13 +30,9 @@ fuzz_target!(|input: (Vec<u8>, Vec<u8>)| {
 
     let mut sliced = UplinkParser::new();
     let mut by_slice = Vec::new();
-    let mut rest = &bytes[..];
-    let mut cut = cuts.iter().cycle();
-    while !rest.is_empty() {
-        let n = cut.next().map_or(rest.len(), |c| usize::from(*c).max(1)).min(rest.len());
-        let (now, later) = rest.split_at(n);
-        by_slice.extend(sliced.frames(now));
-        rest = later;
+    let cuts: Vec<usize> = cuts.iter().map(|c| usize::from(*c)).collect();
+    for piece in pieces(&bytes, &cuts) {
+        by_slice.extend(sliced.frames(piece));
     }
     assert_eq!(by_slice, by_byte);
     assert_eq!(sliced.stats(), one.stats());
