@@ -75,6 +75,8 @@ mod bytes;
 pub mod command;
 mod error;
 pub mod parse;
+#[cfg(feature = "sim")]
+pub mod sim;
 pub mod telemetry;
 mod wire;
 
