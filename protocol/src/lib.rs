@@ -53,6 +53,8 @@
 //! * `serde`: `Serialize` / `Deserialize` for the typed frames and counters.
 //! * `std`: links `std` (nothing needs it yet).
 //! * `arbitrary`: `arbitrary::Arbitrary` for the frames, for fuzzing (values `decode` can return).
+//! * `driver`: the master-side [`driver`] (sans-IO core, blocking shell over embedded-io 0.7).
+//! * `sim`: the board simulator ([`sim`]); with `driver`, also an in-memory UART to it.
 
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
@@ -73,11 +75,14 @@
 mod arbitrary;
 mod bytes;
 pub mod command;
+#[cfg(feature = "driver")]
+pub mod driver;
 mod error;
 pub mod parse;
 #[cfg(feature = "sim")]
 pub mod sim;
 pub mod telemetry;
+pub mod units;
 mod wire;
 
 pub use bytes::FrameBytes;

@@ -579,6 +579,88 @@ impl Board {
     }
 }
 
+/// The board behind an in-memory UART (features `sim` and `driver`): `embedded-io` `Read`,
+/// `Write` and `ReadReady`, for testing a master, or the [`crate::driver`], on the host. The
+/// board's time follows a shared [`Cell`](core::cell::Cell) of milliseconds, which
+/// [`SimClock`] advances.
+#[cfg(feature = "driver")]
+#[derive(Debug)]
+pub struct SimUart<'t> {
+    board: Board,
+    time: &'t core::cell::Cell<u64>,
+}
+
+#[cfg(feature = "driver")]
+impl<'t> SimUart<'t> {
+    /// `board` behind a UART, on the clock `time`.
+    pub fn new(board: Board, time: &'t core::cell::Cell<u64>) -> Self {
+        SimUart { board, time }
+    }
+
+    /// The board (to inspect it in a test).
+    pub fn board(&self) -> &Board {
+        &self.board
+    }
+
+    /// The board (to inject faults in a test).
+    pub fn board_mut(&mut self) -> &mut Board {
+        &mut self.board
+    }
+
+    fn catch_up(&mut self) {
+        self.board.advance(self.time.get());
+    }
+}
+
+#[cfg(feature = "driver")]
+impl embedded_io::ErrorType for SimUart<'_> {
+    type Error = core::convert::Infallible;
+}
+
+#[cfg(feature = "driver")]
+impl embedded_io::Read for SimUart<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> Result<usize, Self::Error> {
+        self.catch_up();
+        Ok(self.board.transmit(buf))
+    }
+}
+
+#[cfg(feature = "driver")]
+impl embedded_io::ReadReady for SimUart<'_> {
+    fn read_ready(&mut self) -> Result<bool, Self::Error> {
+        self.catch_up();
+        Ok(!self.board.out.is_empty())
+    }
+}
+
+#[cfg(feature = "driver")]
+impl embedded_io::Write for SimUart<'_> {
+    fn write(&mut self, buf: &[u8]) -> Result<usize, Self::Error> {
+        self.catch_up();
+        self.board.receive(buf);
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> Result<(), Self::Error> {
+        Ok(())
+    }
+}
+
+/// A simulated clock: every reading moves the shared time on by 1 ms, so a driver that polls
+/// makes time pass. Share the cell with a [`SimUart`].
+#[cfg(feature = "driver")]
+#[derive(Clone, Copy, Debug)]
+pub struct SimClock<'t>(pub &'t core::cell::Cell<u64>);
+
+#[cfg(feature = "driver")]
+impl crate::driver::Clock for SimClock<'_> {
+    fn now_ms(&mut self) -> u64 {
+        let now = self.0.get().saturating_add(1);
+        self.0.set(now);
+        now
+    }
+}
+
 fn clamp_i32(v: i64) -> i32 {
     i32::try_from(v.clamp(i64::from(i32::MIN), i64::from(i32::MAX))).unwrap_or(0)
 }
