@@ -372,14 +372,25 @@ impl Board {
         self.commands = self.commands.wrapping_add(1);
         match command {
             Command::Velocity(v) => {
-                self.motion = Motion::Velocity { x: v.x, y: v.y, z: v.z };
+                self.motion = Motion::Velocity {
+                    x: v.x,
+                    y: v.y,
+                    z: v.z,
+                };
             }
             Command::Turn(t) => {
                 // The hazard the spec warns about: every angle frame adds up.
-                self.motion = Motion::Velocity { x: t.x, y: t.y, z: 0 };
-                self.pending_deci_degrees = self.pending_deci_degrees.saturating_add(i64::from(t.deci_degrees));
-                self.total_turn_deci_degrees =
-                    self.total_turn_deci_degrees.saturating_add(i64::from(t.deci_degrees));
+                self.motion = Motion::Velocity {
+                    x: t.x,
+                    y: t.y,
+                    z: 0,
+                };
+                self.pending_deci_degrees = self
+                    .pending_deci_degrees
+                    .saturating_add(i64::from(t.deci_degrees));
+                self.total_turn_deci_degrees = self
+                    .total_turn_deci_degrees
+                    .saturating_add(i64::from(t.deci_degrees));
             }
             Command::Motors(m) => self.motion = Motion::Motors(m.values),
             Command::Setting(setting) => self.setting(setting),
@@ -387,7 +398,9 @@ impl Board {
     }
 
     fn setting(&mut self, setting: Setting) {
-        self.quiet_until_ms = self.now_ms.saturating_add(u64::from(self.config.resume_after_ms));
+        self.quiet_until_ms = self
+            .now_ms
+            .saturating_add(u64::from(self.config.resume_after_ms));
         match setting {
             Setting::Action(action) => self.action(action),
             Setting::Write(write) => {
@@ -407,7 +420,9 @@ impl Board {
                     Register::GyroCalibration if self.calibrating() => 0xFFFF,
                     other => self.live.read(other).unwrap_or(0),
                 };
-                let due = self.now_ms.saturating_add(u64::from(self.config.reply_delay_ms));
+                let due = self
+                    .now_ms
+                    .saturating_add(u64::from(self.config.reply_delay_ms));
                 let _ = self.replies.push_back((due, Reply::new(register, value)));
             }
             Setting::Raw { .. } => {}
@@ -422,7 +437,8 @@ impl Board {
                 // System-mode bit 3 is not stored.
                 let compensation = self.stored.system_mode.gyro_compensation();
                 self.stored = self.live;
-                self.stored.system_mode = self.stored.system_mode.with_gyro_compensation(compensation);
+                self.stored.system_mode =
+                    self.stored.system_mode.with_gyro_compensation(compensation);
             }
             Action::GyroCompensationOff => {
                 self.live.system_mode = self.live.system_mode.with_gyro_compensation(false);
@@ -457,7 +473,10 @@ impl Board {
         }
         let sending = !self.faults.telemetry_stopped && !self.telemetry_paused();
         for stream in 0..3 {
-            let (Some(due), Some(period)) = (self.next_due_ms.get(stream).copied(), PERIODS_MS.get(stream)) else {
+            let (Some(due), Some(period)) = (
+                self.next_due_ms.get(stream).copied(),
+                PERIODS_MS.get(stream),
+            ) else {
                 continue;
             };
             if now < due {
@@ -496,7 +515,12 @@ impl Board {
 
     fn move_chassis(&mut self) {
         let speeds = self.wheel_speeds();
-        for ((ticks, carry), speed) in self.wheel_ticks.iter_mut().zip(&mut self.tick_carry).zip(speeds) {
+        for ((ticks, carry), speed) in self
+            .wheel_ticks
+            .iter_mut()
+            .zip(&mut self.tick_carry)
+            .zip(speeds)
+        {
             // Ticks per second → per ms, carrying the remainder.
             let total = carry.saturating_add(speed);
             let whole = total / 1_000;
@@ -504,7 +528,9 @@ impl Board {
             *ticks = ticks.wrapping_add(whole as i16);
         }
         if self.pending_deci_degrees != 0 {
-            let step = self.pending_deci_degrees.clamp(-TURN_DECI_DEGREES_PER_MS, TURN_DECI_DEGREES_PER_MS);
+            let step = self
+                .pending_deci_degrees
+                .clamp(-TURN_DECI_DEGREES_PER_MS, TURN_DECI_DEGREES_PER_MS);
             self.pending_deci_degrees = self.pending_deci_degrees.saturating_sub(step);
             self.turn_carry = step;
         } else {
@@ -535,21 +561,39 @@ impl Board {
                 let turning = clamp_i32(self.turn_carry.saturating_mul(100));
                 let gyro_z = rotation.saturating_add(turning).clamp(-32_768, 32_767) as i16;
                 Telemetry::Imu(Imu {
-                    accel: [noise(self), noise(self), 16_384i16.wrapping_add(noise(self))],
+                    accel: [
+                        noise(self),
+                        noise(self),
+                        16_384i16.wrapping_add(noise(self)),
+                    ],
                     gyro: [noise(self), noise(self), gyro_z.saturating_add(noise(self))],
                     seq,
                 })
             }
-            1 => Telemetry::Encoders(Encoders { ticks: self.wheel_ticks, seq }),
+            1 => Telemetry::Encoders(Encoders {
+                ticks: self.wheel_ticks,
+                seq,
+            }),
             _ => {
-                let (full, cutoff) = match (self.live.battery_full_centivolts, self.live.battery_cutoff_centivolts) {
+                let (full, cutoff) = match (
+                    self.live.battery_full_centivolts,
+                    self.live.battery_cutoff_centivolts,
+                ) {
                     (0x7FFF, _) | (_, 0x7FFF) => (1_260, 1_050),
                     (full, cutoff) => (full, cutoff),
                 };
                 let span = u32::from(full.saturating_sub(cutoff)).max(1);
                 let above = u32::from(self.centivolts.saturating_sub(cutoff));
-                let percent = above.saturating_mul(100).checked_div(span).unwrap_or(0).min(100) as u16;
-                Telemetry::Battery(Battery { centivolts: self.centivolts, percent, seq })
+                let percent = above
+                    .saturating_mul(100)
+                    .checked_div(span)
+                    .unwrap_or(0)
+                    .min(100) as u16;
+                Telemetry::Battery(Battery {
+                    centivolts: self.centivolts,
+                    percent,
+                    seq,
+                })
             }
         }
     }

@@ -30,7 +30,11 @@ pub fn degrees_to_deci_degrees(degrees: f32) -> i32 {
         0
     } else {
         // `as` saturates for floats; add 0.5 away from zero to round.
-        (if scaled < 0.0 { scaled - 0.5 } else { scaled + 0.5 }) as i32
+        (if scaled < 0.0 {
+            scaled - 0.5
+        } else {
+            scaled + 0.5
+        }) as i32
     }
 }
 
@@ -41,7 +45,11 @@ pub fn percent_to_centi_percent(percent: f32) -> i32 {
     if scaled.is_nan() {
         0
     } else {
-        (if scaled < 0.0 { scaled - 0.5 } else { scaled + 0.5 }) as i32
+        (if scaled < 0.0 {
+            scaled - 0.5
+        } else {
+            scaled + 0.5
+        }) as i32
     }
 }
 

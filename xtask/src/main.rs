@@ -123,7 +123,12 @@ fn sweep() -> Result<(), String> {
 fn test() -> Result<(), String> {
     install_targets(&THUMB_TARGETS)?;
     cargo(&["fmt", "--all", "--check"])?;
-    cargo(&["fmt", "--check", "--manifest-path", "host-tests/fuzz/Cargo.toml"])?;
+    cargo(&[
+        "fmt",
+        "--check",
+        "--manifest-path",
+        "host-tests/fuzz/Cargo.toml",
+    ])?;
     cargo(&[
         "clippy",
         "--workspace",

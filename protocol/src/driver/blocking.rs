@@ -60,6 +60,17 @@ where
         (self.uart, self.clock)
     }
 
+    /// The UART (to inspect it; the driver keeps it).
+    pub const fn uart(&self) -> &U {
+        &self.uart
+    }
+
+    /// The UART, mutably (for a test double's controls; do not read from or write to it behind
+    /// the driver's back).
+    pub fn uart_mut(&mut self) -> &mut U {
+        &mut self.uart
+    }
+
     /// The sans-IO core: latest telemetry, stream rates, parser counters, link state.
     pub const fn core(&self) -> &DriverCore {
         &self.core
@@ -112,7 +123,10 @@ where
                 Some(Event::StrayReply(reply)) => {
                     // Give the read up: the caller hears of the wrong reply.
                     self.core.cancel_read();
-                    return Err(Error::WrongReply { expected: register, got: reply.code });
+                    return Err(Error::WrongReply {
+                        expected: register,
+                        got: reply.code,
+                    });
                 }
                 _ => {}
             }
@@ -121,6 +135,29 @@ where
                 return Err(Error::Timeout(register));
             }
         }
+    }
+
+    /// Reads a register until two replies agree (at most three reads). There is no checksum: a
+    /// byte changed on the line changes a reply's value unseen, so settings that matter are
+    /// worth reading this way. Two disagreeing replies and a third that matches neither is
+    /// [`Error::Unconfirmed`].
+    pub fn read_register_verified(&mut self, register: Register) -> Result<Reply, Error<U::Error>> {
+        let mut first = None;
+        let mut second = None;
+        for _ in 0..3 {
+            let reply = match self.read_register(register) {
+                Ok(reply) => reply,
+                // A reply lost or garbled on the line: try again.
+                Err(Error::Timeout(_) | Error::WrongReply { .. }) => continue,
+                Err(e) => return Err(e),
+            };
+            if first == Some(reply) || second == Some(reply) {
+                return Ok(reply);
+            }
+            second = first;
+            first = Some(reply);
+        }
+        Err(Error::Unconfirmed(register))
     }
 
     /// Writes one register (2B). The board does not answer writes.

@@ -20,8 +20,8 @@
 //! Time is milliseconds from any origin, as a `u64`; it must not go back. The blocking shell
 //! reads it from a [`Clock`].
 
-mod sans_io;
 pub mod blocking;
+mod sans_io;
 mod settings;
 
 pub use sans_io::{DriverCore, Event, Stamped, StreamInfo};
@@ -74,7 +74,11 @@ impl Config {
         const BITS: u64 = (10 + 15 + 6) * 10;
         let baud = if self.baud == 0 { 1 } else { self.baud as u64 };
         let wire = (BITS * 1_000).div_ceil(baud);
-        let wire = if wire > u32::MAX as u64 { u32::MAX } else { wire as u32 };
+        let wire = if wire > u32::MAX as u64 {
+            u32::MAX
+        } else {
+            wire as u32
+        };
         wire.saturating_add(self.board_latency_ms)
     }
 }
@@ -107,6 +111,8 @@ pub enum Error<E> {
     TurnInProgress,
     /// The UART accepted no bytes (a write returned 0).
     WriteZero,
+    /// Replies to reads of this register disagreed (bytes changed on the line).
+    Unconfirmed(Register),
 }
 
 impl<E> From<E> for Error<E> {
@@ -126,6 +132,7 @@ impl<E: fmt::Debug> fmt::Display for Error<E> {
             Error::Busy => f.write_str("a read is already waiting for its reply"),
             Error::TurnInProgress => f.write_str("a turn is still outstanding"),
             Error::WriteZero => f.write_str("the UART accepted no bytes"),
+            Error::Unconfirmed(r) => write!(f, "replies to reads of {r:?} disagreed"),
         }
     }
 }

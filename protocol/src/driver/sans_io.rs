@@ -38,7 +38,8 @@ impl StreamInfo {
     fn arrived(&mut self, at_ms: u64) {
         self.frames = self.frames.wrapping_add(1);
         if let Some(last) = self.last_ms {
-            let gap_us = u32::try_from(at_ms.saturating_sub(last).saturating_mul(1_000)).unwrap_or(u32::MAX);
+            let gap_us =
+                u32::try_from(at_ms.saturating_sub(last).saturating_mul(1_000)).unwrap_or(u32::MAX);
             // Exponential smoothing, 1/8 of the new interval.
             self.interval_us = if self.interval_us == 0 {
                 gap_us
@@ -102,7 +103,12 @@ impl DriverCore {
             imu: None,
             encoders: None,
             battery: None,
-            streams: [StreamInfo { frames: 0, missed: 0, interval_us: 0, last_ms: None }; 3],
+            streams: [StreamInfo {
+                frames: 0,
+                missed: 0,
+                interval_us: 0,
+                last_ms: None,
+            }; 3],
             last_telemetry_ms: None,
             last_byte_ms: None,
             moving_since_ms: None,
@@ -161,7 +167,11 @@ impl DriverCore {
 
     /// Bytes of a settings frame. A read arms the reply matching and its timeout; a second read
     /// while one waits is [`Error::Busy`].
-    pub fn setting<E>(&mut self, setting: Setting, now_ms: u64) -> Result<[u8; Setting::LEN], Error<E>> {
+    pub fn setting<E>(
+        &mut self,
+        setting: Setting,
+        now_ms: u64,
+    ) -> Result<[u8; Setting::LEN], Error<E>> {
         if let Setting::Read(register) = setting {
             if self.waiting.is_some() {
                 return Err(Error::Busy);
@@ -285,7 +295,10 @@ impl DriverCore {
     /// Rate and drops of one stream.
     #[must_use]
     pub fn stream(&self, stream: Stream) -> StreamInfo {
-        self.streams.get(stream.index()).copied().unwrap_or_default()
+        self.streams
+            .get(stream.index())
+            .copied()
+            .unwrap_or_default()
     }
 
     /// The parser's counters.
@@ -311,15 +324,24 @@ impl DriverCore {
     fn frame(&mut self, frame: Telemetry, now_ms: u64) -> Option<Event> {
         let stream = match frame {
             Telemetry::Imu(value) => {
-                self.imu = Some(Stamped { value, at_ms: now_ms });
+                self.imu = Some(Stamped {
+                    value,
+                    at_ms: now_ms,
+                });
                 Stream::Imu
             }
             Telemetry::Encoders(value) => {
-                self.encoders = Some(Stamped { value, at_ms: now_ms });
+                self.encoders = Some(Stamped {
+                    value,
+                    at_ms: now_ms,
+                });
                 Stream::Encoders
             }
             Telemetry::Battery(value) => {
-                self.battery = Some(Stamped { value, at_ms: now_ms });
+                self.battery = Some(Stamped {
+                    value,
+                    at_ms: now_ms,
+                });
                 Stream::Battery
             }
             Telemetry::Reply(reply) => return Some(self.reply(reply)),
@@ -358,7 +380,11 @@ mod tests {
     #[test]
     fn reply_timeout_follows_the_baud_rate() {
         assert_eq!(Config::DEFAULT.reply_timeout_ms(), 3 + 50);
-        let slow = Config { baud: 9_600, board_latency_ms: 0, ..Config::DEFAULT };
+        let slow = Config {
+            baud: 9_600,
+            board_latency_ms: 0,
+            ..Config::DEFAULT
+        };
         assert_eq!(slow.reply_timeout_ms(), 33);
     }
 
@@ -367,12 +393,17 @@ mod tests {
         let mut core = DriverCore::new(Config::DEFAULT);
         assert!(core.turn::<Infallible>(900, 0).is_ok());
         assert_eq!(core.turn::<Infallible>(900, 1), Err(E::TurnInProgress));
-        core.setting::<Infallible>(Setting::Read(Register::PendingAngle), 2).unwrap();
+        core.setting::<Infallible>(Setting::Read(Register::PendingAngle), 2)
+            .unwrap();
         let (event, _) = core.receive(&Reply::new(Register::PendingAngle, 450).encode(), 3);
-        assert!(event.is_none(), "a lone reply waits for the next header or a quiet line");
+        assert!(
+            event.is_none(),
+            "a lone reply waits for the next header or a quiet line"
+        );
         assert!(matches!(core.quiet(10), Some(Event::Reply(_))));
         assert!(core.turning(), "still 45.0° to go");
-        core.setting::<Infallible>(Setting::Read(Register::PendingAngle), 20).unwrap();
+        core.setting::<Infallible>(Setting::Read(Register::PendingAngle), 20)
+            .unwrap();
         // After a quiet line the parser takes the next byte as a frame start: out at once.
         let (event, _) = core.receive(&Reply::new(Register::PendingAngle, 0).encode(), 21);
         assert!(matches!(event, Some(Event::Reply(_))));
@@ -396,8 +427,12 @@ mod tests {
     #[test]
     fn reads_time_out_and_a_second_read_is_busy() {
         let mut core = DriverCore::new(Config::DEFAULT);
-        core.setting::<Infallible>(Setting::Read(Register::SpeedKp), 0).unwrap();
-        assert_eq!(core.setting::<Infallible>(Setting::Read(Register::SpeedKi), 1), Err(E::Busy));
+        core.setting::<Infallible>(Setting::Read(Register::SpeedKp), 0)
+            .unwrap();
+        assert_eq!(
+            core.setting::<Infallible>(Setting::Read(Register::SpeedKi), 1),
+            Err(E::Busy)
+        );
         assert_eq!(core.reply_timed_out(53), None);
         assert_eq!(core.reply_timed_out(54), Some(Register::SpeedKp));
         assert_eq!(core.waiting_for(), None);

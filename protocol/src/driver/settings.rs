@@ -56,7 +56,10 @@ impl Settings {
             Write::SystemMode(m) => self.system_mode = m,
             Write::GyroCalibration(v) => self.gyro_calibration = v,
             Write::MotorVoltage { centivolts } => self.motor_centivolts = centivolts,
-            Write::BatteryRange { full_centivolts, cutoff_centivolts } => {
+            Write::BatteryRange {
+                full_centivolts,
+                cutoff_centivolts,
+            } => {
                 self.battery_full_centivolts = full_centivolts;
                 self.battery_cutoff_centivolts = cutoff_centivolts;
             }
@@ -74,7 +77,9 @@ impl Settings {
             Write::SpeedKi(self.speed_ki),
             Write::GyroGain(self.gyro_gain),
             Write::SystemMode(self.system_mode),
-            Write::MotorVoltage { centivolts: self.motor_centivolts },
+            Write::MotorVoltage {
+                centivolts: self.motor_centivolts,
+            },
             Write::BatteryRange {
                 full_centivolts: self.battery_full_centivolts,
                 cutoff_centivolts: self.battery_cutoff_centivolts,
