@@ -219,6 +219,20 @@ pub struct Board {
     dropped_frames: u32,
 }
 
+#[cfg(feature = "defmt")]
+impl defmt::Format for Board {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(
+            f,
+            "Board {{ now_ms: {=u64}, motion: {}, pending_deci_degrees: {=i64}, queued: {=usize} }}",
+            self.now_ms,
+            self.motion,
+            self.pending_deci_degrees,
+            self.out.len()
+        );
+    }
+}
+
 impl Board {
     /// A board just powered up with factory settings, at time 0, standing still.
     #[must_use]
@@ -687,6 +701,37 @@ impl embedded_io::Write for SimUart<'_> {
 
     fn flush(&mut self) -> Result<(), Self::Error> {
         Ok(())
+    }
+}
+
+#[cfg(feature = "async")]
+impl embedded_io_async::Read for SimUart<'_> {
+    async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Self::Error> {
+        embedded_io::Read::read(self, buf)
+    }
+}
+
+#[cfg(feature = "async")]
+impl embedded_io_async::Write for SimUart<'_> {
+    async fn write(&mut self, buf: &[u8]) -> Result<usize, Self::Error> {
+        embedded_io::Write::write(self, buf)
+    }
+
+    async fn flush(&mut self) -> Result<(), Self::Error> {
+        Ok(())
+    }
+}
+
+/// A simulated delay for the async driver: waiting moves the shared time on.
+#[cfg(feature = "async")]
+#[derive(Clone, Copy, Debug)]
+pub struct SimDelay<'t>(pub &'t core::cell::Cell<u64>);
+
+#[cfg(feature = "async")]
+impl embedded_hal_async::delay::DelayNs for SimDelay<'_> {
+    async fn delay_ns(&mut self, ns: u32) {
+        let ms = u64::from(ns.div_ceil(1_000_000));
+        self.0.set(self.0.get().saturating_add(ms));
     }
 }
 

@@ -150,24 +150,17 @@ fn test() -> Result<(), String> {
     cargo(&["test", "--workspace"])?;
     cargo(&["test", "-p", "chassis-protocol", "--all-features"])?;
     for target in THUMB_TARGETS {
-        cargo(&[
-            "build",
-            "-p",
-            "chassis-protocol",
-            "--release",
-            "--target",
-            target,
-        ])?;
-        cargo(&[
-            "build",
-            "-p",
-            "chassis-protocol",
-            "--release",
-            "--target",
-            target,
-            "--features",
-            "defmt,serde",
-        ])?;
+        for features in ["", "defmt,serde", "driver,nb,async,sim,defmt,serde"] {
+            let build = [
+                "build",
+                "-p",
+                "chassis-protocol",
+                "--release",
+                "--target",
+                target,
+            ];
+            cargo(&[&build[..], &["--features", features]].concat())?;
+        }
     }
     // Every public item documented, every intra-doc link resolved.
     run_with(

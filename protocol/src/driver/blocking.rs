@@ -29,6 +29,7 @@ const RX: usize = 32;
 /// The blocking driver: owns the UART and the clock (give them back with
 /// [`release`](Driver::release)); bytes read but not yet parsed are kept between calls.
 #[derive(Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Driver<U, C> {
     uart: U,
     clock: C,

@@ -4,6 +4,8 @@
 //! |---|---|---|
 //! | [`DriverCore`] | all the logic: frames out, telemetry in, reply matching, timeouts, the failsafe, one-shot turns | nothing: bytes and the time come in as arguments |
 //! | [`blocking::Driver`] | owns the UART and a [`Clock`]; blocking calls | `embedded-io` 0.7 `Read + Write + ReadReady` |
+//! | `nb::NbSerial` (feature `nb`) | adapts an `embedded-hal-nb` 1.0 serial port for `blocking::Driver` | `serial::Read<u8> + serial::Write<u8>` |
+//! | `asynch::Driver` (feature `async`) | the same calls, `async` | `embedded-io-async` 0.7 + `embedded-hal-async` `DelayNs` |
 //!
 //! # The angle hazard, and how the driver takes it away
 //!
@@ -20,7 +22,11 @@
 //! Time is milliseconds from any origin, as a `u64`; it must not go back. The blocking shell
 //! reads it from a [`Clock`].
 
+#[cfg(feature = "async")]
+pub mod asynch;
 pub mod blocking;
+#[cfg(feature = "nb")]
+pub mod nb;
 mod sans_io;
 mod settings;
 

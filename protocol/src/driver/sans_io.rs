@@ -92,6 +92,15 @@ pub struct DriverCore {
     failsafe_stops: u32,
 }
 
+// RAM budget of the core (the parser, latest frames, stream figures, timers): 360 bytes on
+// thumbv7em and on 64-bit hosts alike (u64 is 8-aligned on both).
+const _: () = assert!(
+    core::mem::size_of::<DriverCore>() <= 384,
+    "DriverCore over its RAM budget"
+);
+#[cfg(target_arch = "arm")]
+const _: () = assert!(core::mem::size_of::<DriverCore>() == 360);
+
 impl DriverCore {
     /// A core that has heard nothing and sent nothing.
     #[must_use]
