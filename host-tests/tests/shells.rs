@@ -1,8 +1,10 @@
-//! The `nb` and async shells against the simulator: the same driver logic through an
-//! `embedded-hal-nb` serial port, and through `embedded-io-async` on a host executor.
+//! The `nb` and async shells and the `embedded-io` 0.6 adapter against the simulator: the same
+//! driver logic through an `embedded-hal-nb` serial port, an `embedded-io` 0.6 UART, and
+//! `embedded-io-async` on a host executor.
 
 use chassis_protocol::driver::asynch::Driver as AsyncDriver;
 use chassis_protocol::driver::blocking::Driver;
+use chassis_protocol::driver::io06::Io06;
 use chassis_protocol::driver::nb::NbSerial;
 use chassis_protocol::driver::{Config, Error};
 use chassis_protocol::sim::{Board, Faults, Motion, SimClock, SimConfig, SimDelay, SimUart};
@@ -105,4 +107,48 @@ fn async_shell_times_out_on_a_silent_board() {
     let waited = time.get();
     let timeout = u64::from(Config::DEFAULT.reply_timeout_ms());
     assert!((timeout..timeout + 5).contains(&waited), "{waited} ms");
+}
+
+/// The simulated board as an `embedded-io` 0.6 UART.
+struct Uart06<'t>(SimUart<'t>);
+
+impl embedded_io_06::ErrorType for Uart06<'_> {
+    type Error = Infallible;
+}
+
+impl embedded_io_06::Read for Uart06<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> Result<usize, Infallible> {
+        self.0.read(buf)
+    }
+}
+
+impl embedded_io_06::ReadReady for Uart06<'_> {
+    fn read_ready(&mut self) -> Result<bool, Infallible> {
+        self.0.read_ready()
+    }
+}
+
+impl embedded_io_06::Write for Uart06<'_> {
+    fn write(&mut self, buf: &[u8]) -> Result<usize, Infallible> {
+        self.0.write(buf)
+    }
+
+    fn flush(&mut self) -> Result<(), Infallible> {
+        Ok(())
+    }
+}
+
+#[test]
+fn embedded_io_06_uarts_work_through_the_adapter() {
+    let time = Cell::new(0);
+    let uart = Uart06(SimUart::new(Board::new(SimConfig::default()), &time));
+    let mut d = Driver::new(Io06(uart), SimClock(&time), Config::DEFAULT);
+    d.write(Write::GyroGain(4_242)).unwrap();
+    assert_eq!(d.read_register(Register::GyroGain).unwrap().value, 4_242);
+    d.set_velocity(Velocity::new(1, 2, 3)).unwrap();
+    let (Io06(uart), _) = d.release();
+    assert_eq!(
+        uart.0.board().motion(),
+        Motion::Velocity { x: 1, y: 2, z: 3 }
+    );
 }

@@ -5,6 +5,7 @@
 //! | [`DriverCore`] | all the logic: frames out, telemetry in, reply matching, timeouts, the failsafe, one-shot turns | nothing: bytes and the time come in as arguments |
 //! | [`blocking::Driver`] | owns the UART and a [`Clock`]; blocking calls | `embedded-io` 0.7 `Read + Write + ReadReady` |
 //! | `nb::NbSerial` (feature `nb`) | adapts an `embedded-hal-nb` 1.0 serial port for `blocking::Driver` | `serial::Read<u8> + serial::Write<u8>` |
+//! | `io06::Io06` (feature `embedded-io-06`) | adapts an `embedded-io` 0.6 UART for `blocking::Driver` | 0.6 `Read + Write + ReadReady` |
 //! | `asynch::Driver` (feature `async`) | the same calls, `async` | `embedded-io-async` 0.7 + `embedded-hal-async` `DelayNs` |
 //!
 //! # The angle hazard, and how the driver takes it away
@@ -25,6 +26,8 @@
 #[cfg(feature = "async")]
 pub mod asynch;
 pub mod blocking;
+#[cfg(feature = "embedded-io-06")]
+pub mod io06;
 #[cfg(feature = "nb")]
 pub mod nb;
 mod sans_io;

@@ -171,7 +171,7 @@ struct State {
     weak: bool,
     /// While Tentative: frames so far whose count continued their stream.
     confirms: u8,
-    /// Frames accepted since the last one that continued its count (saturating).
+    /// Telemetry frames accepted since the last one that continued its count (saturating).
     since_continued: u8,
     /// The last `poll` emitted a frame: another may be ready without a new byte.
     drain: bool,
@@ -601,10 +601,11 @@ impl DownlinkParser {
         state.window.drop_front(len);
         self.stats.count_frame(frame.kind());
         let confirms = continuity == Continuity::Continues;
-        state.since_continued = if confirms {
-            0
-        } else {
-            state.since_continued.saturating_add(1)
+        state.since_continued = match continuity {
+            Continuity::Continues => 0,
+            // A reply carries no count: it neither confirms an alignment nor counts against it.
+            Continuity::Reply => state.since_continued,
+            _ => state.since_continued.saturating_add(1),
         };
         state.weak = match continuity {
             _ if state.lock == Lock::Hunting => true,
