@@ -3,7 +3,7 @@
 //! one-shot turn, the failsafe, the reply timeout, telemetry rates, the settings snapshot.
 
 use chassis_protocol::driver::{Config, Error, Event, Settings, blocking::Driver};
-use chassis_protocol::sim::{Board, Faults, Motion, Registers, SimClock, SimConfig, SimUart};
+use chassis_protocol::sim::{Board, FACTORY, Faults, Motion, SimClock, SimConfig, SimUart};
 use chassis_protocol::{
     Action, DriveType, Motors, Register, Stream, SystemMode, Telemetry, Velocity, Write,
 };
@@ -111,7 +111,7 @@ fn actions_store_load_and_defaults() {
     d.action(Action::LoadDefaults).unwrap();
     assert_eq!(
         d.read_register(Register::MaxSpeed).unwrap().value,
-        u32::from(Registers::FACTORY.max_speed)
+        u32::from(FACTORY.max_speed)
     );
     d.action(Action::LoadStored).unwrap();
     assert_eq!(d.read_register(Register::MaxSpeed).unwrap().value, 42);
@@ -317,7 +317,7 @@ fn the_settings_snapshot_reads_in_one_call_and_serialises_with_postcard() {
     let mut d = driver(&time);
     d.write(Write::SpeedKp(999)).unwrap();
     let settings = d.read_settings().unwrap();
-    let factory = Registers::FACTORY;
+    let factory = FACTORY;
     assert_eq!(settings.speed_kp, 999);
     assert_eq!(settings.max_speed, factory.max_speed);
     assert_eq!(settings.system_mode, factory.system_mode);

@@ -79,6 +79,7 @@ pub mod command;
 pub mod driver;
 mod error;
 pub mod parse;
+pub mod registers;
 #[cfg(feature = "sim")]
 pub mod sim;
 pub mod telemetry;
@@ -92,4 +93,5 @@ pub use command::{
 };
 pub use error::Error;
 pub use parse::{DownlinkParser, DownlinkStats, Lock, UplinkParser, UplinkStats};
+pub use registers::Settings;
 pub use telemetry::{Battery, Encoders, Imu, Kind, Reply, Stream, Telemetry, TelemetryBytes};

@@ -47,6 +47,7 @@
 
 use crate::command::{Action, Command, DriveType, Register, Setting, SystemMode, Write};
 use crate::parse::UplinkParser;
+use crate::registers::Settings;
 use crate::telemetry::{Battery, Encoders, Imu, Reply, Telemetry};
 use heapless::Deque;
 
@@ -91,82 +92,18 @@ pub struct Faults {
     pub replies_stopped: bool,
 }
 
-/// The board's registers (one copy).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Registers {
-    /// `0x01`.
-    pub max_speed: u16,
-    /// `0x06`.
-    pub speed_kp: u32,
-    /// `0x07`.
-    pub speed_ki: u32,
-    /// `0x08`, 0.00001.
-    pub gyro_gain: u32,
-    /// `0x09`.
-    pub system_mode: SystemMode,
-    /// `0x0A`.
-    pub gyro_calibration: u16,
-    /// `0x0B`, 0.01 V.
-    pub motor_centivolts: u16,
-    /// `0x0C` high half, 0.01 V (0x7FFF: built-in table).
-    pub battery_full_centivolts: u16,
-    /// `0x0C` low half, 0.01 V (0x7FFF: built-in table).
-    pub battery_cutoff_centivolts: u16,
-}
-
-impl Registers {
-    /// The factory defaults of the model (the vendor does not publish them; these are chosen).
-    pub const FACTORY: Registers = Registers {
-        max_speed: 1_000,
-        speed_kp: 300,
-        speed_ki: 20,
-        gyro_gain: 50_000,
-        system_mode: SystemMode::new(DriveType::Mecanum),
-        gyro_calibration: 0x0200,
-        motor_centivolts: 1_200,
-        battery_full_centivolts: 0x7FFF,
-        battery_cutoff_centivolts: 0x7FFF,
-    };
-
-    /// The value a read of `register` returns (the pending angle is not a register here).
-    #[must_use]
-    pub fn read(&self, register: Register) -> Option<u32> {
-        Some(match register {
-            Register::MaxSpeed => u32::from(self.max_speed),
-            Register::SpeedKp => self.speed_kp,
-            Register::SpeedKi => self.speed_ki,
-            Register::GyroGain => self.gyro_gain,
-            Register::SystemMode => self.system_mode.bits(),
-            Register::GyroCalibration => u32::from(self.gyro_calibration),
-            Register::MotorVoltage => u32::from(self.motor_centivolts),
-            Register::BatteryRange => {
-                (u32::from(self.battery_full_centivolts) << 16)
-                    | u32::from(self.battery_cutoff_centivolts)
-            }
-            Register::PendingAngle => return None,
-        })
-    }
-
-    fn write(&mut self, write: Write) {
-        match write {
-            Write::MaxSpeed(v) => self.max_speed = v,
-            Write::SpeedKp(v) => self.speed_kp = v,
-            Write::SpeedKi(v) => self.speed_ki = v,
-            Write::GyroGain(v) => self.gyro_gain = v,
-            Write::SystemMode(m) => self.system_mode = m,
-            Write::GyroCalibration(v) => self.gyro_calibration = v,
-            Write::MotorVoltage { centivolts } => self.motor_centivolts = centivolts,
-            Write::BatteryRange {
-                full_centivolts,
-                cutoff_centivolts,
-            } => {
-                self.battery_full_centivolts = full_centivolts;
-                self.battery_cutoff_centivolts = cutoff_centivolts;
-            }
-        }
-    }
-}
+/// The factory defaults of the model (the vendor does not publish them; these are chosen).
+pub const FACTORY: Settings = Settings {
+    max_speed: 1_000,
+    speed_kp: 300,
+    speed_ki: 20,
+    gyro_gain: 50_000,
+    system_mode: SystemMode::new(DriveType::Mecanum),
+    gyro_calibration: 0x0200,
+    motor_centivolts: 1_200,
+    battery_full_centivolts: 0x7FFF,
+    battery_cutoff_centivolts: 0x7FFF,
+};
 
 /// What the chassis was last told to do.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -199,8 +136,8 @@ pub struct Board {
     faults: Faults,
     uplink: UplinkParser,
     now_ms: u64,
-    live: Registers,
-    stored: Registers,
+    live: Settings,
+    stored: Settings,
     motion: Motion,
     pending_deci_degrees: i64,
     total_turn_deci_degrees: i64,
@@ -242,8 +179,8 @@ impl Board {
             faults: Faults::default(),
             uplink: UplinkParser::new(),
             now_ms: 0,
-            live: Registers::FACTORY,
-            stored: Registers::FACTORY,
+            live: FACTORY,
+            stored: FACTORY,
             motion: Motion::Velocity { x: 0, y: 0, z: 0 },
             pending_deci_degrees: 0,
             total_turn_deci_degrees: 0,
@@ -330,13 +267,13 @@ impl Board {
 
     /// The live registers.
     #[must_use]
-    pub const fn registers(&self) -> &Registers {
+    pub const fn registers(&self) -> &Settings {
         &self.live
     }
 
     /// The stored registers.
     #[must_use]
-    pub const fn stored_registers(&self) -> &Registers {
+    pub const fn stored_registers(&self) -> &Settings {
         &self.stored
     }
 
@@ -419,7 +356,7 @@ impl Board {
             Setting::Action(action) => self.action(action),
             Setting::Write(write) => {
                 let compensation_was = self.live.system_mode.gyro_compensation();
-                self.live.write(write);
+                self.live.set(write);
                 match write {
                     Write::GyroCalibration(0xFFFF) => self.start_calibration(),
                     Write::SystemMode(mode) if mode.gyro_compensation() && !compensation_was => {
@@ -432,7 +369,7 @@ impl Board {
                 let value = match register {
                     Register::PendingAngle => self.pending_deci_degrees() as u32,
                     Register::GyroCalibration if self.calibrating() => 0xFFFF,
-                    other => self.live.read(other).unwrap_or(0),
+                    other => self.live.value(other).unwrap_or(0),
                 };
                 let due = self
                     .now_ms
@@ -446,7 +383,7 @@ impl Board {
     fn action(&mut self, action: Action) {
         match action {
             Action::LoadStored => self.live = self.stored,
-            Action::LoadDefaults => self.live = Registers::FACTORY,
+            Action::LoadDefaults => self.live = FACTORY,
             Action::Store => {
                 // System-mode bit 3 is not stored.
                 let compensation = self.stored.system_mode.gyro_compensation();

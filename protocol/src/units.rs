@@ -25,32 +25,13 @@ pub fn deci_degrees_to_degrees(deci_degrees: i32) -> f32 {
 /// Degrees → 0.1°, rounded, saturating.
 #[must_use]
 pub fn degrees_to_deci_degrees(degrees: f32) -> i32 {
-    let scaled = degrees * 10.0;
-    if scaled.is_nan() {
-        0
-    } else {
-        // `as` saturates for floats; add 0.5 away from zero to round.
-        (if scaled < 0.0 {
-            scaled - 0.5
-        } else {
-            scaled + 0.5
-        }) as i32
-    }
+    round_i32(degrees * 10.0)
 }
 
 /// Percent → 0.01 % duty, rounded, clamped to ±100.00 %.
 #[must_use]
 pub fn percent_to_centi_percent(percent: f32) -> i32 {
-    let scaled = (percent * 100.0).clamp(-10_000.0, 10_000.0);
-    if scaled.is_nan() {
-        0
-    } else {
-        (if scaled < 0.0 {
-            scaled - 0.5
-        } else {
-            scaled + 0.5
-        }) as i32
-    }
+    round_i32((percent * 100.0).clamp(-10_000.0, 10_000.0))
 }
 
 /// Gyro compensation gain in units of 0.00001 → the gain.
@@ -64,6 +45,17 @@ pub fn gyro_gain_to_f32(raw: u32) -> f32 {
 pub fn gyro_gain_from_f32(gain: f32) -> u32 {
     let scaled = gain * 100_000.0 + 0.5;
     if scaled.is_nan() { 0 } else { scaled as u32 }
+}
+
+/// Rounds half away from zero; `as` saturates, and NaN becomes 0.
+fn round_i32(value: f32) -> i32 {
+    if value.is_nan() {
+        0
+    } else if value < 0.0 {
+        (value - 0.5) as i32
+    } else {
+        (value + 0.5) as i32
+    }
 }
 
 fn saturate_u16(value: f32) -> u16 {

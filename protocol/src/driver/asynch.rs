@@ -2,8 +2,9 @@
 //! `Read + Write + ReadReady` (embassy-stm32, embassy-rp), with an `embedded-hal-async`
 //! `DelayNs` to wait between polls. The same calls as the blocking driver, `async`.
 
-use super::{Clock, Config, DriverCore, Error, Event, Settings};
+use super::{Clock, Config, DriverCore, Error, Event};
 use crate::command::{Action, Motors, Register, Setting, Velocity, Write};
+use crate::registers::Settings;
 use crate::telemetry::Reply;
 use embedded_hal_async::delay::DelayNs;
 use embedded_io_async::{Read, ReadReady, Write as IoWrite};

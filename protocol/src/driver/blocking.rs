@@ -18,8 +18,9 @@
 //! # Ok::<(), chassis_protocol::driver::Error<core::convert::Infallible>>(())
 //! ```
 
-use super::{Clock, Config, DriverCore, Error, Event, Settings};
+use super::{Clock, Config, DriverCore, Error, Event};
 use crate::command::{Action, Motors, Register, Setting, Velocity, Write};
+use crate::registers::Settings;
 use crate::telemetry::Reply;
 use embedded_io::{Read, ReadReady, Write as IoWrite};
 

@@ -31,10 +31,9 @@ pub mod io06;
 #[cfg(feature = "nb")]
 pub mod nb;
 mod sans_io;
-mod settings;
 
+pub use crate::registers::Settings;
 pub use sans_io::{DriverCore, Event, Stamped, StreamInfo};
-pub use settings::Settings;
 
 use crate::command::Register;
 use core::fmt;

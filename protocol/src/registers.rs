@@ -1,4 +1,5 @@
-//! [`Settings`]: every readable register, read in one call, written back in one call.
+//! [`Settings`]: a snapshot of every readable register — what the driver reads in one call and
+//! writes back in one call, and what the board simulator keeps (live and stored copies).
 
 use crate::command::{Register, SystemMode, Write};
 use crate::telemetry::Reply;
@@ -45,9 +46,37 @@ impl Settings {
     /// Takes in the reply to one of [`Settings::REGISTERS`]; `false` for any other reply, or a
     /// value that does not fit its register.
     pub fn apply(&mut self, reply: &Reply) -> bool {
-        let Some(write) = reply.as_write() else {
-            return false;
-        };
+        match reply.as_write() {
+            Some(write) => {
+                self.set(write);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The value a read of `register` returns: as its reply carries it (`None` for the pending
+    /// angle, which is no setting).
+    #[must_use]
+    pub fn value(&self, register: Register) -> Option<u32> {
+        Some(match register {
+            Register::MaxSpeed => u32::from(self.max_speed),
+            Register::SpeedKp => self.speed_kp,
+            Register::SpeedKi => self.speed_ki,
+            Register::GyroGain => self.gyro_gain,
+            Register::SystemMode => self.system_mode.bits(),
+            Register::GyroCalibration => u32::from(self.gyro_calibration),
+            Register::MotorVoltage => u32::from(self.motor_centivolts),
+            Register::BatteryRange => {
+                (u32::from(self.battery_full_centivolts) << 16)
+                    | u32::from(self.battery_cutoff_centivolts)
+            }
+            Register::PendingAngle => return None,
+        })
+    }
+
+    /// Applies a register write.
+    pub fn set(&mut self, write: Write) {
         match write {
             Write::MaxSpeed(v) => self.max_speed = v,
             Write::SpeedKp(v) => self.speed_kp = v,
@@ -64,7 +93,6 @@ impl Settings {
                 self.battery_cutoff_centivolts = cutoff_centivolts;
             }
         }
-        true
     }
 
     /// The writes that put these settings back on a board. The gyro calibration value is left
