@@ -78,46 +78,52 @@ fn cargo(args: &[&str]) -> Result<(), String> {
 
 /// Adds the rustup targets that are not installed yet.
 fn install_targets(targets: &[&str]) -> Result<(), String> {
-    let installed = Command::new("rustup")
-        .args(["target", "list", "--installed"])
-        .output()
-        .map_err(|e| format!("rustup is needed to add {targets:?}: {e}"))?;
-    let installed = String::from_utf8_lossy(&installed.stdout);
+    let installed = rustup_list(&["target", "list", "--installed"])?;
     let missing: Vec<&str> = targets
         .iter()
         .copied()
-        .filter(|t| !installed.lines().any(|line| line.trim() == *t))
+        .filter(|t| !installed.iter().any(|line| line.trim() == *t))
         .collect();
     if missing.is_empty() {
         return Ok(());
     }
-    let mut args = vec!["target", "add"];
-    args.extend(missing);
-    run("rustup", &args)
+    run("rustup", &[&["target", "add"][..], &missing].concat())
+}
+
+/// The lines `rustup <args>` prints.
+fn rustup_list(args: &[&str]) -> Result<Vec<String>, String> {
+    let output = Command::new("rustup")
+        .args(args)
+        .output()
+        .map_err(|e| format!("rustup is needed (rustup {}): {e}", args.join(" ")))?;
+    Ok(String::from_utf8_lossy(&output.stdout)
+        .lines()
+        .map(str::to_string)
+        .collect())
+}
+
+/// Runs a release build of a `chassis-host-tests` binary or example (`kind` is `--bin` or
+/// `--example`).
+fn host_tests(kind: &str, name: &str, args: &[&str]) -> Result<(), String> {
+    let run = [
+        "run",
+        "--release",
+        "--quiet",
+        "-p",
+        "chassis-host-tests",
+        kind,
+        name,
+        "--",
+    ];
+    cargo(&[&run[..], args].concat())
 }
 
 fn demo() -> Result<(), String> {
-    cargo(&[
-        "run",
-        "--release",
-        "--quiet",
-        "-p",
-        "chassis-host-tests",
-        "--example",
-        "demo",
-    ])
+    host_tests("--example", "demo", &[])
 }
 
 fn sweep() -> Result<(), String> {
-    cargo(&[
-        "run",
-        "--release",
-        "--quiet",
-        "-p",
-        "chassis-host-tests",
-        "--bin",
-        "noise-sweep",
-    ])
+    host_tests("--bin", "noise-sweep", &[])
 }
 
 fn test() -> Result<(), String> {
@@ -188,17 +194,7 @@ fn fuzz(seconds: u32) -> Result<(), String> {
     let fuzz_dir = root.join("host-tests").join("fuzz");
     let corpus = fuzz_dir.join("corpus");
     let corpus_arg = corpus.to_string_lossy().into_owned();
-    cargo(&[
-        "run",
-        "--release",
-        "--quiet",
-        "-p",
-        "chassis-host-tests",
-        "--bin",
-        "fuzz-seeds",
-        "--",
-        &corpus_arg,
-    ])?;
+    host_tests("--bin", "fuzz-seeds", &[&corpus_arg])?;
     let max_time = format!("-max_total_time={seconds}");
     for target in FUZZ_TARGETS {
         let target_corpus = corpus.join(target).to_string_lossy().into_owned();
@@ -236,12 +232,8 @@ fn workspace_root() -> Result<std::path::PathBuf, String> {
 
 /// Installs the nightly toolchain (minimal profile) if it is missing: cargo-fuzz needs it.
 fn install_nightly() -> Result<(), String> {
-    let toolchains = Command::new("rustup")
-        .args(["toolchain", "list"])
-        .output()
-        .map_err(|e| format!("rustup is needed to install nightly: {e}"))?;
-    if String::from_utf8_lossy(&toolchains.stdout)
-        .lines()
+    if rustup_list(&["toolchain", "list"])?
+        .iter()
         .any(|l| l.starts_with("nightly"))
     {
         return Ok(());
