@@ -3,7 +3,7 @@
 //! | task | what it does |
 //! |---|---|
 //! | `demo` | the main job: today a host demo (frames built, a noisy board stream parsed) |
-//! | `test` | everything CI checks: format, lints, tests, docs, `no_std` builds for Cortex-M, and a short run of every fuzz target |
+//! | `test` | everything CI checks: format, lints, tests, docs, `no_std` builds for Cortex-M, the link-time no-panic proof, and a short run of every fuzz target |
 //! | `fuzz [SECONDS]` | only the fuzz targets, each for SECONDS (default 30) |
 //! | `sweep` | the full noise sweep of the downlink parser (about a minute; not part of `test`) |
 //!
@@ -168,6 +168,17 @@ fn test() -> Result<(), String> {
             cargo(&[&build[..], &["--features", features]].concat())?;
         }
     }
+    // The link-time proof that the byte-facing functions cannot panic: this links only if the
+    // compiler removed every panic path from them.
+    cargo(&[
+        "build",
+        "--profile",
+        "no-panic",
+        "-p",
+        "chassis-host-tests",
+        "--example",
+        "no_panic",
+    ])?;
     // Every public item documented, every intra-doc link resolved.
     run_with(
         &cargo_program(),

@@ -306,7 +306,7 @@ impl DownlinkParser {
                 }
                 continue;
             }
-            let step = self.bytes_before_decision().clamp(1, bytes.len());
+            let step = self.bytes_before_decision().max(1).min(bytes.len());
             let (now, later) = bytes.split_at_checked(step).unwrap_or((bytes, &[]));
             self.append(now);
             bytes = later;

@@ -88,7 +88,7 @@ impl UplinkParser {
     /// Feeds bytes until a command comes out; returns it and the bytes not yet consumed.
     pub fn push_slice<'a>(&mut self, mut bytes: &'a [u8]) -> (Option<Command>, &'a [u8]) {
         while !bytes.is_empty() {
-            let step = self.bytes_before_decision().clamp(1, bytes.len());
+            let step = self.bytes_before_decision().max(1).min(bytes.len());
             let (now, rest) = bytes.split_at_checked(step).unwrap_or((bytes, &[]));
             bytes = rest;
             for &byte in now {

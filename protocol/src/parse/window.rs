@@ -48,18 +48,15 @@ impl<const N: usize> Window<N> {
     #[inline]
     pub(crate) fn extend(&mut self, bytes: &[u8]) -> usize {
         let start = self.len();
-        let room = N.saturating_sub(start);
-        let take = bytes.len().min(room);
-        if let (Some(dst), Some(src)) = (
-            self.bytes.get_mut(start..start.saturating_add(take)),
-            bytes.get(..take),
-        ) {
-            dst.copy_from_slice(src);
-            self.len = u8::try_from(start.saturating_add(take)).unwrap_or(self.len);
-            take
-        } else {
-            0
+        let mut taken: usize = 0;
+        if let Some(dst) = self.bytes.get_mut(start..) {
+            for (d, s) in dst.iter_mut().zip(bytes) {
+                *d = *s;
+                taken = taken.saturating_add(1);
+            }
         }
+        self.len = u8::try_from(start.saturating_add(taken)).unwrap_or(self.len);
+        taken
     }
 
     /// Drops the first `n` bytes (all of them if `n` is larger).
