@@ -31,6 +31,10 @@
 //! | [`command`] | master → board: [`Velocity`], [`Turn`], [`Motors`], [`Setting`] ([`Action`], [`Write`], [`Register`] reads), [`SystemMode`] |
 //! | [`telemetry`] | board → master: [`Imu`], [`Encoders`], [`Battery`], [`Reply`] |
 //! | [`parse`] | [`DownlinkParser`] (board → master), [`UplinkParser`] (master → board), their counters |
+//! | [`registers`] | [`Settings`]: a snapshot of every readable register |
+//! | [`units`] | conversions where the spec states the unit |
+//! | `driver` (feature) | the master-side driver: sans-IO core, blocking / `nb` / async shells |
+//! | `sim` (feature) | the board simulator |
 //!
 //! There is no checksum in this protocol, and a gyro at rest writes false headers into every
 //! other IMU payload: how the board → master parser resynchronises, and the trade-off it makes
@@ -53,8 +57,9 @@
 //! * `serde`: `Serialize` / `Deserialize` for the typed frames and counters.
 //! * `std`: links `std` (nothing needs it yet).
 //! * `arbitrary`: `arbitrary::Arbitrary` for the frames, for fuzzing (values `decode` can return).
-//! * `driver`: the master-side [`driver`] (sans-IO core, blocking shell over embedded-io 0.7).
-//! * `sim`: the board simulator ([`sim`]); with `driver`, also an in-memory UART to it.
+//! * `driver`: the master-side driver, module `driver` (sans-IO core, blocking shell over
+//!   embedded-io 0.7); `nb`, `async`, `embedded-io-06`: its other shells and adapters.
+//! * `sim`: the board simulator, module `sim`; with `driver`, also an in-memory UART to it.
 
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
