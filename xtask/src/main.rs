@@ -180,17 +180,10 @@ fn test() -> Result<(), String> {
         "no_panic",
     ])?;
     // Every public item documented, every intra-doc link resolved.
-    run_with(
-        &cargo_program(),
-        &[
-            "doc",
-            "-p",
-            "chassis-protocol",
-            "--no-deps",
-            "--all-features",
-        ],
-        &[("RUSTDOCFLAGS", "-D warnings")],
-    )?;
+    for features in ["--no-default-features", "--all-features"] {
+        let doc = ["doc", "-p", "chassis-protocol", "--no-deps", features];
+        run_with(&cargo_program(), &doc, &[("RUSTDOCFLAGS", "-D warnings")])?;
+    }
     fuzz(30)
 }
 
