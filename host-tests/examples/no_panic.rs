@@ -6,7 +6,7 @@
 //! be inlined for the proof), so a panic path reachable from untrusted bytes breaks CI:
 //!
 //! ```text
-//! cargo build --profile no-panic -p chassis-host-tests --example no_panic
+//! cargo build --profile no-panic -p chassis-host-tests --features no-panic-proof --example no_panic
 //! ```
 
 use chassis_protocol::{

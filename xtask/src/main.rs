@@ -176,6 +176,8 @@ fn test() -> Result<(), String> {
         "no-panic",
         "-p",
         "chassis-host-tests",
+        "--features",
+        "no-panic-proof",
         "--example",
         "no_panic",
     ])?;
