@@ -181,6 +181,53 @@ impl BoardStream {
     }
 }
 
+/// `count` frames of the board simulator's own output ([`chassis_protocol::sim::Board`]): its
+/// telemetry at real rates, and a register read every half second whose reply comes while
+/// telemetry pauses (as the spec says it does during settings). Frame boundaries are found by
+/// decoding the clean output in order.
+pub fn simulator_stream(seed: u64, count: usize) -> (Vec<u8>, Vec<SentFrame>) {
+    use chassis_protocol::sim::{Board, SimConfig};
+    use chassis_protocol::{Kind, Register, Setting};
+    let mut board = Board::new(SimConfig {
+        seed,
+        ..SimConfig::default()
+    });
+    let mut bytes = Vec::with_capacity(count * 15);
+    let mut buf = [0u8; 256];
+    let mut ms = 0u64;
+    // About 126 frames a second; stop once enough bytes for `count` frames have come.
+    while bytes.len() < count * 15 {
+        ms += 1;
+        if ms % 500 == 0 {
+            let register = Register::ALL[(ms / 500) as usize % Register::ALL.len()];
+            board.receive(&Setting::Read(register).encode());
+        }
+        board.advance(ms);
+        let n = board.transmit(&mut buf);
+        bytes.extend_from_slice(&buf[..n]);
+    }
+    let mut frames = Vec::with_capacity(count);
+    let mut at = 0;
+    while let [a, b, ..] = bytes[at..] {
+        let Some(kind) = Kind::from_header(a, b) else {
+            break;
+        };
+        let Some(raw) = bytes.get(at..at + kind.len()) else {
+            break;
+        };
+        let Ok(frame) = Telemetry::decode(raw) else {
+            break;
+        };
+        frames.push(SentFrame { start: at, frame });
+        at += kind.len();
+        if frames.len() == count {
+            break;
+        }
+    }
+    bytes.truncate(at);
+    (bytes, frames)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -218,6 +265,14 @@ mod tests {
             false_headers as f64 > 0.4 * imu,
             "{false_headers} false headers in {imu} IMU frames"
         );
+    }
+
+    #[test]
+    fn the_simulators_stream_is_whole_frames_back_to_back() {
+        let (bytes, frames) = simulator_stream(3, 2_000);
+        assert_eq!(frames.len(), 2_000);
+        assert_eq!(frames.last().map(SentFrame::end), Some(bytes.len()));
+        assert!(frames.iter().any(|f| f.frame.kind() == Kind::Reply));
     }
 
     #[test]

@@ -8,6 +8,7 @@
 //! Prints a Markdown table: recall of untouched frames, false frames per million sent, untouched
 //! frames lost per channel error, latency, and the parser's own counters.
 
+use chassis_host_tests::board::simulator_stream;
 use chassis_host_tests::channel::{Noise, transmit};
 use chassis_host_tests::{BoardStream, Score, score_downlink, startup};
 use rand::SeedableRng;
@@ -113,6 +114,29 @@ fn main() -> ExitCode {
             s.latency_max,
         );
     }
+    // The same channel over the board simulator's own output (telemetry at real rates, a read
+    // every half second answered while telemetry pauses).
+    for rate in [1e-4, 1e-3, 1e-2] {
+        let (bytes, sent) = simulator_stream(args.seed, args.frames);
+        let rx = transmit(
+            &bytes,
+            &Noise::mixed(rate),
+            &mut Pcg64Mcg::seed_from_u64(args.seed ^ 0x5EED),
+        );
+        let s = score_downlink(&sent, &rx);
+        println!(
+            "| simulator, mixed | {rate:.0e} | {} | {} | {:.3} % | {:.1} | {:.3} | {:.2} % | {:.2} / {} |",
+            s.errors,
+            s.untouched,
+            s.recall() * 100.0,
+            s.false_per_million(),
+            s.lost_per_error(),
+            s.on_time_locked as f64 * 100.0 / s.recalled_locked.max(1) as f64,
+            s.mean_latency(),
+            s.latency_max,
+        );
+    }
+
     let seeds = 500;
     let s = startup(0..seeds, 40);
     println!(
