@@ -390,24 +390,3 @@ fn a_reply_on_a_quiet_line_comes_out_on_idle_or_at_once_when_aligned() {
         })]
     );
 }
-
-#[test]
-fn probe_bounds() {
-    let (frames, bytes) = long_stream();
-    let starts = starts();
-    let mut worst = 0;
-    for offset in 0..starts[20] {
-        let mut parser = DownlinkParser::new();
-        let out = parse_chunked(&mut parser, &bytes[offset..], 7);
-        let first = starts.iter().position(|s| *s >= offset).unwrap_or(50);
-        let r = frames_to_recover(&out, &frames, first).unwrap_or(99);
-        if r > 4 {
-            println!(
-                "offset {offset}: {r} frames, {} bytes",
-                starts[first + r] - offset
-            );
-        }
-        worst = worst.max(r);
-    }
-    println!("worst {worst}");
-}
