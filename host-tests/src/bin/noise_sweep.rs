@@ -58,6 +58,21 @@ fn run(noise: &Noise, frames: usize, seed: u64) -> Score {
     score_downlink(&sent, &rx)
 }
 
+/// One row of the table.
+fn print_row(name: &str, rate: f64, s: &Score) {
+    println!(
+        "| {name} | {rate:.0e} | {} | {} | {:.3} % | {:.1} | {:.3} | {:.2} % | {:.2} / {} |",
+        s.errors,
+        s.untouched,
+        s.recall() * 100.0,
+        s.false_per_million(),
+        s.lost_per_error(),
+        s.on_time_locked as f64 * 100.0 / s.recalled_locked.max(1) as f64,
+        s.mean_latency(),
+        s.latency_max,
+    );
+}
+
 fn main() -> ExitCode {
     let args = match parse_args() {
         Ok(args) => args,
@@ -102,17 +117,7 @@ fn main() -> ExitCode {
     }
     for (name, rate, noise) in rows {
         let s = run(&noise, args.frames, args.seed);
-        println!(
-            "| {name} | {rate:.0e} | {} | {} | {:.3} % | {:.1} | {:.3} | {:.2} % | {:.2} / {} |",
-            s.errors,
-            s.untouched,
-            s.recall() * 100.0,
-            s.false_per_million(),
-            s.lost_per_error(),
-            s.on_time_locked as f64 * 100.0 / s.recalled_locked.max(1) as f64,
-            s.mean_latency(),
-            s.latency_max,
-        );
+        print_row(&name, rate, &s);
     }
     // The same channel over the board simulator's own output (telemetry at real rates, a read
     // every half second answered while telemetry pauses).
@@ -124,17 +129,7 @@ fn main() -> ExitCode {
             &mut Pcg64Mcg::seed_from_u64(args.seed ^ 0x5EED),
         );
         let s = score_downlink(&sent, &rx);
-        println!(
-            "| simulator, mixed | {rate:.0e} | {} | {} | {:.3} % | {:.1} | {:.3} | {:.2} % | {:.2} / {} |",
-            s.errors,
-            s.untouched,
-            s.recall() * 100.0,
-            s.false_per_million(),
-            s.lost_per_error(),
-            s.on_time_locked as f64 * 100.0 / s.recalled_locked.max(1) as f64,
-            s.mean_latency(),
-            s.latency_max,
-        );
+        print_row("simulator, mixed", rate, &s);
     }
 
     let seeds = 500;
