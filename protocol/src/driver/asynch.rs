@@ -2,15 +2,12 @@
 //! `Read + Write + ReadReady` (embassy-stm32, embassy-rp), with an `embedded-hal-async`
 //! `DelayNs` to wait between polls. The same calls as the blocking driver, `async`.
 
-use super::{Clock, Config, DriverCore, Error, Event};
+use super::{Clock, Config, DriverCore, Error, Event, RxBuffer};
 use crate::command::{Action, Motors, Register, Setting, Velocity, Write};
 use crate::registers::Settings;
 use crate::telemetry::Reply;
 use embedded_hal_async::delay::DelayNs;
 use embedded_io_async::{Read, ReadReady, Write as IoWrite};
-
-/// Bytes read from the UART at a time.
-const RX: usize = 32;
 
 /// The async driver: owns the UART, the clock and the delay (give them back with
 /// [`release`](Driver::release)).
@@ -21,9 +18,7 @@ pub struct Driver<U, C, D> {
     clock: C,
     delay: D,
     core: DriverCore,
-    rx: [u8; RX],
-    rx_start: usize,
-    rx_end: usize,
+    rx: RxBuffer,
 }
 
 // RAM of the driver itself, without the UART, clock (and delay) it owns: 400 bytes on ARM.
@@ -43,9 +38,7 @@ where
             clock,
             delay,
             core: DriverCore::new(config),
-            rx: [0; RX],
-            rx_start: 0,
-            rx_end: 0,
+            rx: RxBuffer::new(),
         }
     }
 
@@ -150,20 +143,14 @@ where
             self.send(&stop).await?;
         }
         loop {
-            if self.rx_start < self.rx_end {
-                let pending = self.rx.get(self.rx_start..self.rx_end).unwrap_or(&[]);
-                let (event, rest) = self.core.receive(pending, now);
-                self.rx_start = self.rx_end.saturating_sub(rest.len());
-                if event.is_some() {
-                    return Ok(event);
-                }
+            if let Some(event) = self.rx.drain(&mut self.core, now) {
+                return Ok(Some(event));
             }
             if !self.uart.read_ready()? {
                 return Ok(self.core.quiet(now));
             }
-            let n = self.uart.read(&mut self.rx).await?;
-            self.rx_start = 0;
-            self.rx_end = n.min(RX);
+            let n = self.uart.read(self.rx.space()).await?;
+            self.rx.filled(n);
             if n == 0 {
                 return Ok(None);
             }

@@ -18,14 +18,11 @@
 //! # Ok::<(), chassis_protocol::driver::Error<core::convert::Infallible>>(())
 //! ```
 
-use super::{Clock, Config, DriverCore, Error, Event};
+use super::{Clock, Config, DriverCore, Error, Event, RxBuffer};
 use crate::command::{Action, Motors, Register, Setting, Velocity, Write};
 use crate::registers::Settings;
 use crate::telemetry::Reply;
 use embedded_io::{Read, ReadReady, Write as IoWrite};
-
-/// Bytes read from the UART at a time.
-const RX: usize = 32;
 
 /// The blocking driver: owns the UART and the clock (give them back with
 /// [`release`](Driver::release)); bytes read but not yet parsed are kept between calls.
@@ -35,9 +32,7 @@ pub struct Driver<U, C> {
     uart: U,
     clock: C,
     core: DriverCore,
-    rx: [u8; RX],
-    rx_start: usize,
-    rx_end: usize,
+    rx: RxBuffer,
 }
 
 // RAM of the driver itself, without the UART, clock (and delay) it owns: 400 bytes on ARM.
@@ -55,9 +50,7 @@ where
             uart,
             clock,
             core: DriverCore::new(config),
-            rx: [0; RX],
-            rx_start: 0,
-            rx_end: 0,
+            rx: RxBuffer::new(),
         }
     }
 
@@ -203,20 +196,14 @@ where
             self.send(&stop)?;
         }
         loop {
-            if self.rx_start < self.rx_end {
-                let pending = self.rx.get(self.rx_start..self.rx_end).unwrap_or(&[]);
-                let (event, rest) = self.core.receive(pending, now);
-                self.rx_start = self.rx_end.saturating_sub(rest.len());
-                if event.is_some() {
-                    return Ok(event);
-                }
+            if let Some(event) = self.rx.drain(&mut self.core, now) {
+                return Ok(Some(event));
             }
             if !self.uart.read_ready()? {
                 return Ok(self.core.quiet(now));
             }
-            let n = self.uart.read(&mut self.rx)?;
-            self.rx_start = 0;
-            self.rx_end = n.min(RX);
+            let n = self.uart.read(self.rx.space())?;
+            self.rx.filled(n);
             if n == 0 {
                 return Ok(None);
             }

@@ -33,7 +33,7 @@ pub mod nb;
 mod sans_io;
 
 pub use crate::registers::Settings;
-pub use sans_io::{DriverCore, Event, Stamped, StreamInfo};
+pub use sans_io::{DriverCore, Event, RxBuffer, Stamped, StreamInfo};
 
 use crate::command::Register;
 use core::fmt;

@@ -64,6 +64,60 @@ pub enum Event {
     StrayReply(Reply),
 }
 
+/// Bytes read from the UART but not yet through the parser: what a shell keeps between calls so
+/// that nothing is dropped when an event comes out mid-read.
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RxBuffer {
+    bytes: [u8; RxBuffer::LEN],
+    start: usize,
+    end: usize,
+}
+
+impl Default for RxBuffer {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl RxBuffer {
+    /// Bytes read from the UART at a time.
+    pub const LEN: usize = 32;
+
+    /// An empty buffer.
+    #[must_use]
+    pub const fn new() -> Self {
+        RxBuffer {
+            bytes: [0; Self::LEN],
+            start: 0,
+            end: 0,
+        }
+    }
+
+    /// Feeds the bytes held to `core` until one completes an event.
+    pub fn drain(&mut self, core: &mut DriverCore, now_ms: u64) -> Option<Event> {
+        if self.start >= self.end {
+            return None;
+        }
+        let pending = self.bytes.get(self.start..self.end).unwrap_or(&[]);
+        let (event, rest) = core.receive(pending, now_ms);
+        self.start = self.end.saturating_sub(rest.len());
+        event
+    }
+
+    /// Where to read into: the whole buffer (call only once [`drain`](Self::drain) has
+    /// emptied it), then [`filled`](Self::filled) with the count read.
+    pub fn space(&mut self) -> &mut [u8] {
+        &mut self.bytes
+    }
+
+    /// Records that `n` bytes were read into [`space`](Self::space).
+    pub fn filled(&mut self, n: usize) {
+        self.start = 0;
+        self.end = n.min(Self::LEN);
+    }
+}
+
 /// The turn guard: see the module docs of [`crate::driver`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
