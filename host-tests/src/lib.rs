@@ -7,6 +7,7 @@
 pub mod board;
 pub mod channel;
 pub mod score;
+pub mod splice;
 
 pub use board::{BoardStream, SentFrame};
 pub use channel::{Noise, Received};

@@ -3,8 +3,8 @@
 //! | task | what it does |
 //! |---|---|
 //! | `demo` | the main job: today a host demo (frames built, a noisy board stream parsed) |
-//! | `test` | everything CI checks: format, lints, tests, docs, `no_std` builds for Cortex-M, the link-time no-panic proof, and a short run of every fuzz target |
-//! | `fuzz [SECONDS]` | only the fuzz targets, each for SECONDS (default 30) |
+//! | `test` | everything CI checks: format, lints, tests, docs, `no_std` builds for Cortex-M, the link-time no-panic proof, and a short, repeatable run of every fuzz target (fixed seed and run count) |
+//! | `fuzz [SECONDS]` | only the fuzz targets, each for SECONDS (default 30), exploring: random seed, corpora kept |
 //! | `sweep` | the full noise sweep of the downlink parser (about a minute; not part of `test`) |
 //!
 //! Each task installs what it needs (rustup targets, the nightly toolchain and cargo-fuzz)
@@ -24,7 +24,7 @@ fn main() -> ExitCode {
         "fuzz" => {
             let seconds = std::env::args().nth(2).unwrap_or_else(|| "30".to_string());
             match seconds.parse::<u32>() {
-                Ok(s) if s > 0 => fuzz(s),
+                Ok(s) if s > 0 => fuzz(FuzzRun::Explore(s)),
                 _ => Err(format!(
                     "fuzz takes a number of seconds per target, not {seconds:?}"
                 )),
@@ -186,34 +186,66 @@ fn test() -> Result<(), String> {
         let doc = ["doc", "-p", "chassis-protocol", "--no-deps", features];
         run_with(&cargo_program(), &doc, &[("RUSTDOCFLAGS", "-D warnings")])?;
     }
-    fuzz(30)
+    fuzz(FuzzRun::Repeatable)
 }
 
-/// The fuzz targets, in `host-tests/fuzz`.
-const FUZZ_TARGETS: [&str; 4] = ["downlink", "uplink", "roundtrip", "spliced"];
+/// The fuzz targets, in `host-tests/fuzz`, each with the number of runs `test` gives it (about
+/// 30 s each here).
+const FUZZ_TARGETS: [(&str, u32); 4] = [
+    ("downlink", 500_000),
+    ("uplink", 500_000),
+    ("roundtrip", 1_000_000),
+    ("spliced", 50_000),
+];
 
-/// Runs every fuzz target for `seconds`, from generated seed corpora; fails on any crash.
-fn fuzz(seconds: u32) -> Result<(), String> {
+/// libFuzzer's seed for the runs in `test`.
+const CI_FUZZ_SEED: &str = "2026";
+
+/// How a fuzz run is driven.
+enum FuzzRun {
+    /// `test`: a fixed seed, a fixed number of runs per target (capped at two minutes) and
+    /// corpora generated afresh, so that every CI run goes through the same inputs: CI fails on
+    /// a change to the code, never on the luck of the draw. Exploring is `fuzz`'s job.
+    Repeatable,
+    /// `fuzz SECONDS`: a random seed, each target for SECONDS, corpora kept between runs in
+    /// `host-tests/fuzz/corpus`, so that every run explores further.
+    Explore(u32),
+}
+
+/// Runs every fuzz target, from generated seed corpora; fails on any crash.
+fn fuzz(run: FuzzRun) -> Result<(), String> {
     install_nightly()?;
     install_cargo_fuzz()?;
     let root = workspace_root()?;
     let fuzz_dir = root.join("host-tests").join("fuzz");
-    let corpus = fuzz_dir.join("corpus");
+    let corpus = match run {
+        FuzzRun::Repeatable => {
+            let fresh = root.join("target").join("fuzz-ci-corpus");
+            if fresh.exists() {
+                std::fs::remove_dir_all(&fresh)
+                    .map_err(|e| format!("cannot clear {}: {e}", fresh.display()))?;
+            }
+            fresh
+        }
+        FuzzRun::Explore(_) => fuzz_dir.join("corpus"),
+    };
     let corpus_arg = corpus.to_string_lossy().into_owned();
     host_tests("--bin", "fuzz-seeds", &[&corpus_arg])?;
-    let max_time = format!("-max_total_time={seconds}");
-    for target in FUZZ_TARGETS {
+    for (target, runs) in FUZZ_TARGETS {
         let target_corpus = corpus.join(target).to_string_lossy().into_owned();
+        let limits = match run {
+            FuzzRun::Repeatable => vec![
+                format!("-seed={CI_FUZZ_SEED}"),
+                format!("-runs={runs}"),
+                "-max_total_time=120".to_string(),
+            ],
+            FuzzRun::Explore(seconds) => vec![format!("-max_total_time={seconds}")],
+        };
+        let mut args = vec!["+nightly", "fuzz", "run", target, &target_corpus, "--"];
+        args.extend(limits.iter().map(String::as_str));
+        eprintln!("$ cargo {}", args.join(" "));
         let status = Command::new("cargo")
-            .args([
-                "+nightly",
-                "fuzz",
-                "run",
-                target,
-                &target_corpus,
-                "--",
-                &max_time,
-            ])
+            .args(&args)
             .current_dir(&fuzz_dir)
             .status()
             .map_err(|e| format!("could not start cargo fuzz: {e}"))?;

@@ -42,13 +42,17 @@
 //! [`NEAR_STEPS`] for its stream, one more step for every [`BYTES_PER_FRAME`] of its stream
 //! received since the last confirmed frame; at least [`LOCKED_STEPS`] while Locked), is **far**
 //! from it, or there is no count to compare with (the stream's first frame; or a *provisional*
-//! count, below).
+//! count, below). Or it **continues the last jump**: it is not the next count of its stream, but
+//! the next after the count of the stream's last *jump* (a far count taken while Locked, or a
+//! whole IMU or encoder candidate that a header followed and that was turned down for its count
+//! alone). Two frames in a row then agree that the count has moved on: bytes were lost in a
+//! burst, so more frames went missing than the bytes received since tell.
 //!
 //! | state | on its last byte | two bytes later, if they are a header (or the line is quiet) | otherwise |
 //! |---|---|---|---|
 //! | Hunting | — | count continues or is near (also a provisional count, or any count while none is trusted); a reply holding no header in its value; an IMU or encoder stream's first frame while no count is trusted | reject |
-//! | Tentative | count continues; a reply holding no header | anything but a far count (at most PROBATION_FRAMES in a row without a count that continues) | reject |
-//! | Locked | count continues; a reply holding no header | count near; a reply; a far, provisional or first count only if the frame before was not itself taken on weak evidence (a jump, a hunt) | reject |
+//! | Tentative | count continues; a reply holding no header | anything but a far count (at most PROBATION_FRAMES in a row without a count that continues); a count that continues the last jump only right after a frame whose count continued | reject |
+//! | Locked | count continues; a reply holding no header | count near; a count that continues the last jump; a reply; a far, provisional or first count only if the frame before was not itself taken on weak evidence (a jump, a hunt) | reject |
 //!
 //! A frame exactly delimited by the line going quiet ([`DownlinkParser::idle`]) counts as
 //! followed by a header; while hunting, such a reply or battery frame is taken even without the
@@ -62,9 +66,11 @@
 //!   it confirms a later frame that continues it, but never counts against one (except while
 //!   hunting, where it is the best guess there is, once some count is trusted). A jump on a
 //!   confirmed alignment moves the stream's count on by one, as if the count byte had been
-//!   damaged; a second jump that continues the first re-bases the count (the board restarted
-//!   it). [`DownlinkParser::idle`] makes every count provisional: the board pauses telemetry
-//!   while settings are made, and its counts may have moved on.
+//!   damaged; a frame that continues the last jump re-bases the count (frames were lost, or
+//!   the board restarted its count). Not while hunting: two false candidates can continue each
+//!   other as well as two real frames can. [`DownlinkParser::idle`] makes every count
+//!   provisional: the board pauses telemetry while settings are made, and its counts may have
+//!   moved on.
 //! * After [`FORGET_AFTER`] bytes without a single frame that continues its count, every count is
 //!   forgotten (the board may have restarted; a false alignment may have taught a false count).
 //!   That bounds how long anything can hold the parser off: it can never stay stuck.
@@ -147,6 +153,18 @@ pub enum Lock {
 /// `State::jump_stream` when there is no jump to remember.
 const NO_JUMP: u8 = u8::MAX;
 
+impl State {
+    /// The window's front moved on by `n` bytes: so much nearer the end of the jump candidate.
+    fn passed(&mut self, n: usize) {
+        self.jump_ahead = match u8::try_from(n) {
+            Ok(n) if n <= self.jump_ahead && self.jump_ahead != PASSED => {
+                self.jump_ahead.saturating_sub(n)
+            }
+            _ => PASSED,
+        };
+    }
+}
+
 /// The parsing state proper, counters excluded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -162,8 +180,10 @@ struct State {
     provisional: u8,
     /// The last count of each stream.
     last_seq: [u8; 3],
-    /// The last count jump taken on a confirmed alignment: the stream's index (`NO_JUMP` if
-    /// none) and the count received.
+    /// The last count that jumped: of a frame taken on a confirmed alignment with a far count,
+    /// or of a whole candidate that a header followed but whose count was not plausible. The
+    /// stream's index (`NO_JUMP` if none) and the count. A frame that continues it re-bases its
+    /// stream's count (see [`Continuity::ContinuesJump`]).
     jump_stream: u8,
     jump_seq: u8,
     /// The last frame was taken on weak evidence (a count jump, a hunt): the boundary after it
@@ -175,10 +195,22 @@ struct State {
     since_continued: u8,
     /// The last `poll` emitted a frame: another may be ready without a new byte.
     drain: bool,
-    /// Bytes received since the last frame that continued its count on a Locked alignment
-    /// (saturating).
-    since_confirmed: u16,
+    /// Bytes received since the last frame that continued its count on a Locked alignment, less
+    /// FORGET_AFTER each time the counts are forgotten: never more than FORGET_AFTER + WINDOW.
+    since_confirmed: u8,
+    /// How far the window's front still is from the end of the jump candidate that set
+    /// `jump_stream` (`PASSED` once it is behind): 0 means the candidate at the front starts
+    /// right where that one ended, so the jump candidate's following header is this one.
+    jump_ahead: u8,
 }
+
+/// `State::jump_ahead` once the front has moved past the end of the jump candidate.
+const PASSED: u8 = u8::MAX;
+
+const _: () = assert!(
+    FORGET_AFTER as usize + WINDOW < u8::MAX as usize,
+    "since_confirmed must fit in a byte"
+);
 
 const _: () = assert!(
     core::mem::size_of::<State>() <= 32,
@@ -189,8 +221,9 @@ const _: () = assert!(
 enum Verdict {
     /// Not enough bytes to decide.
     NeedMore,
-    /// The first byte starts no frame: drop it.
-    Reject,
+    /// The first byte starts no frame: drop it. With the stream and count of a whole candidate
+    /// that a header followed, turned down only for its count: remembered as a jump.
+    Reject(Option<(Stream, u8)>),
     /// A frame of this length.
     Accept(Telemetry, usize),
 }
@@ -204,6 +237,11 @@ enum Continuity {
     Unknown,
     /// Exactly the next count.
     Continues,
+    /// Not the next count of its stream, but the next count after the stream's last jump (see
+    /// `State::jump_stream`): two frames in a row agree that the count has moved on (frames were
+    /// lost, a burst of bytes was dropped, the board restarted its count). Taken, when a header
+    /// follows, in every state; the stream's count is re-based on it.
+    ContinuesJump,
     /// Not the next count, but the stream's count is provisional: no evidence either way.
     Provisional,
     /// A few counts on from a trusted count (see [`NEAR_STEPS`]).
@@ -264,6 +302,7 @@ impl DownlinkParser {
                 since_continued: 0,
                 drain: false,
                 since_confirmed: 0,
+                jump_ahead: PASSED,
             },
             stats: DownlinkStats::new(),
         }
@@ -333,7 +372,7 @@ impl DownlinkParser {
                     self.state.drain = false;
                     return None;
                 }
-                Verdict::Reject => self.reject(),
+                Verdict::Reject(jump) => self.reject(jump),
                 Verdict::Accept(frame, len) => {
                     self.accept(&frame, len);
                     self.state.drain = true;
@@ -364,7 +403,7 @@ impl DownlinkParser {
                     self.state.provisional = self.state.seen;
                     return None;
                 }
-                Verdict::Reject => self.reject(),
+                Verdict::Reject(jump) => self.reject(jump),
                 Verdict::Accept(frame, len) => {
                     self.accept(&frame, len);
                     self.state.drain = true;
@@ -409,19 +448,22 @@ impl DownlinkParser {
     fn append(&mut self, mut bytes: &[u8]) {
         while !bytes.is_empty() {
             if self.state.window.is_full() {
-                self.reject();
+                self.reject(None);
             }
             let taken = self.state.window.extend(bytes);
             bytes = bytes.get(taken..).unwrap_or(&[]);
             let state = &mut self.state;
-            let taken = u16::try_from(taken).unwrap_or(u16::MAX);
+            let taken = u8::try_from(taken).unwrap_or(u8::MAX);
             state.since_confirmed = state.since_confirmed.saturating_add(taken);
-            if state.since_confirmed >= FORGET_AFTER {
+            if u16::from(state.since_confirmed) >= FORGET_AFTER {
                 state.seen = 0;
                 state.provisional = 0;
+                state.jump_stream = NO_JUMP;
+                state.jump_ahead = PASSED;
                 // Keep the bytes past the mark, so that bytes fed one at a time and in a slice
                 // leave the same state.
-                state.since_confirmed = state.since_confirmed.saturating_sub(FORGET_AFTER);
+                let forget = u8::try_from(FORGET_AFTER).unwrap_or(u8::MAX);
+                state.since_confirmed = state.since_confirmed.saturating_sub(forget);
             }
         }
     }
@@ -450,13 +492,17 @@ impl DownlinkParser {
             return Continuity::Reply;
         };
         let bit = 1u8 << stream.index();
-        if state.seen & bit == 0 {
-            return Continuity::Unknown;
-        }
         let last = state.last_seq.get(stream.index()).copied().unwrap_or(0);
         let step = seq.wrapping_sub(last);
-        if step == 1 {
+        if state.seen & bit != 0 && step == 1 {
             return Continuity::Continues;
+        }
+        if usize::from(state.jump_stream) == stream.index() && seq.wrapping_sub(state.jump_seq) == 1
+        {
+            return Continuity::ContinuesJump;
+        }
+        if state.seen & bit == 0 {
+            return Continuity::Unknown;
         }
         if provisional & bit != 0 {
             return Continuity::Provisional;
@@ -498,25 +544,24 @@ impl DownlinkParser {
         let (first, second) = match buf {
             [] => return Verdict::NeedMore,
             [first] if Kind::may_start(*first) && !idle => return Verdict::NeedMore,
-            [_] => return Verdict::Reject,
+            [_] => return Verdict::Reject(None),
             [first, second, ..] => (*first, *second),
         };
         let Some(kind) = Kind::from_header(first, second) else {
-            return Verdict::Reject;
+            return Verdict::Reject(None);
         };
         let len = kind.len();
         let Some(bytes) = buf.get(..len) else {
             return if idle {
-                Verdict::Reject
+                Verdict::Reject(None)
             } else {
                 Verdict::NeedMore
             };
         };
         let Ok(frame) = Telemetry::decode(bytes) else {
-            return Verdict::Reject;
+            return Verdict::Reject(None);
         };
         let continuity = self.continuity(&frame);
-        // A truncated reply would hold the next frame's header in its value bytes.
         // A truncated reply would hold the next frame's start in its value bytes, and bytes
         // after its end; one that ends as the line goes quiet is whole.
         let quiet_fit = idle && buf.len() == len;
@@ -545,6 +590,10 @@ impl DownlinkParser {
         let plausible = match state.lock {
             Lock::Hunting => match continuity {
                 Continuity::Continues | Continuity::Near => true,
+                // Two false candidates can continue each other as well as two real frames:
+                // while hunting, only the candidate that starts where the jump candidate ended
+                // (its following header) is taken.
+                Continuity::ContinuesJump => state.jump_ahead == 0,
                 // A count learnt in a hunt may be false, but it is the best guess there is;
                 // while no count is trusted at all (start-up), it is no evidence.
                 Continuity::Provisional => {
@@ -562,9 +611,14 @@ impl DownlinkParser {
                 }
                 Continuity::Far => false,
             },
-            Lock::Tentative => {
-                state.since_continued < PROBATION_FRAMES && continuity != Continuity::Far
-            }
+            Lock::Tentative => match continuity {
+                Continuity::Far => false,
+                // Right after a frame that continued its count, or starting where the jump
+                // candidate ended: on an alignment with nothing better to go by, a re-based
+                // count is as likely a false one.
+                Continuity::ContinuesJump => state.since_continued == 0 || state.jump_ahead == 0,
+                _ => state.since_continued < PROBATION_FRAMES,
+            },
             // On a confirmed alignment, a frame whose count says nothing (a stream's first
             // frame, a provisional count) or jumps is taken when the frame before was taken on
             // good evidence: then this boundary is certain (and a jump is most likely a damaged
@@ -573,20 +627,40 @@ impl DownlinkParser {
                 Continuity::Unknown | Continuity::Provisional | Continuity::Far => {
                     !state.weak || quiet_fit
                 }
-                Continuity::Continues | Continuity::Near | Continuity::Reply => true,
+                Continuity::Continues
+                | Continuity::ContinuesJump
+                | Continuity::Near
+                | Continuity::Reply => true,
             },
         };
-        if followed && plausible {
-            Verdict::Accept(frame, len)
-        } else {
-            Verdict::Reject
+        match (followed, plausible) {
+            (true, true) => Verdict::Accept(frame, len),
+            // Whole and delimited, turned down for its count alone: if the next frame of its
+            // stream continues this count, the count has moved on. Not for the battery: its
+            // frames are a second apart, and a false `FF FC` at an IMU frame's gyro X (-4)
+            // ends on that frame's count byte, so false batteries can continue each other.
+            (true, false) => match (frame.seq(), frame.kind()) {
+                (Some(seq), Kind::Telemetry(stream)) if stream != Stream::Battery => {
+                    Verdict::Reject(Some((stream, seq)))
+                }
+                _ => Verdict::Reject(None),
+            },
+            (false, _) => Verdict::Reject(None),
         }
     }
 
-    /// Drops the candidate's first byte and goes hunting.
-    fn reject(&mut self) {
+    /// Drops the candidate's first byte and goes hunting; remembers `jump` (a stream and a count
+    /// that may have moved on), if any.
+    fn reject(&mut self, jump: Option<(Stream, u8)>) {
         let state = &mut self.state;
         state.window.drop_front(1);
+        state.passed(1);
+        if let Some((stream, seq)) = jump {
+            state.jump_stream = u8::try_from(stream.index()).unwrap_or(NO_JUMP);
+            state.jump_seq = seq;
+            let rest = Kind::Telemetry(stream).len().saturating_sub(1);
+            state.jump_ahead = u8::try_from(rest).unwrap_or(PASSED);
+        }
         self.stats.discarded = self.stats.discarded.wrapping_add(1);
         if state.lock != Lock::Hunting {
             self.stats.lock_losses = self.stats.lock_losses.wrapping_add(1);
@@ -599,6 +673,7 @@ impl DownlinkParser {
         let continuity = self.continuity(frame);
         let state = &mut self.state;
         state.window.drop_front(len);
+        state.passed(len);
         self.stats.count_frame(frame.kind());
         let confirms = continuity == Continuity::Continues;
         state.since_continued = match continuity {
@@ -609,7 +684,7 @@ impl DownlinkParser {
         };
         state.weak = match continuity {
             _ if state.lock == Lock::Hunting => true,
-            Continuity::Continues | Continuity::Near => false,
+            Continuity::Continues | Continuity::ContinuesJump | Continuity::Near => false,
             Continuity::Far => true,
             // A reply (taken with the next header as proof when its value holds one), a
             // stream's first frame, a provisional count: as good a boundary as the frame before.
@@ -630,11 +705,15 @@ impl DownlinkParser {
         if confirms && state.lock == Lock::Locked {
             // Only a confirmed alignment restarts the clock: until then, the bytes since the
             // last certain frame tell how many frames may have been lost.
-            state.since_confirmed = u16::try_from(state.window.len()).unwrap_or(0);
+            state.since_confirmed = u8::try_from(state.window.len()).unwrap_or(0);
         }
         if let (Some(seq), Kind::Telemetry(stream)) = (frame.seq(), frame.kind()) {
+            if continuity == Continuity::ContinuesJump {
+                // Two frames agree the count moved on: follow it.
+                state.jump_stream = NO_JUMP;
+            }
             if state.lock == Lock::Locked && continuity == Continuity::Far {
-                record_jump(state, &mut self.stats, stream, seq);
+                record_jump(state, stream, seq);
             } else {
                 // A count is trusted when it continues the last one (a false frame does that
                 // about one time in 256), or when its frame sits on a confirmed alignment.
@@ -654,22 +733,19 @@ fn holds_a_frame_start(bytes: &[u8]) -> bool {
 
 /// A count jump on a confirmed alignment, right after a frame whose count continued: most likely
 /// the count byte itself was damaged, so the stream's count moves on by one as if it had not
-/// been. If the same stream jumps again and its new count continues the jumped one, the board
-/// really did move its count on (it restarted, or paused its telemetry): the count follows it.
-fn record_jump(state: &mut State, stats: &mut DownlinkStats, stream: Stream, seq: u8) {
+/// been. The jumped count is remembered: if the stream's next frame continues it, the board
+/// really did move its count on (frames were lost, it restarted, or it paused its telemetry),
+/// and the count follows it ([`Continuity::ContinuesJump`]).
+fn record_jump(state: &mut State, stream: Stream, seq: u8) {
     let i = stream.index();
     let Some(last) = state.last_seq.get_mut(i) else {
         return;
     };
-    let again = usize::from(state.jump_stream) == i && state.jump_seq == seq.wrapping_sub(1);
-    if again {
-        state.jump_stream = NO_JUMP;
-        record_seq(state, stats, stream, seq, true);
-    } else {
-        *last = last.wrapping_add(1);
-        state.jump_stream = u8::try_from(i).unwrap_or(NO_JUMP);
-        state.jump_seq = seq;
-    }
+    *last = last.wrapping_add(1);
+    state.jump_stream = u8::try_from(i).unwrap_or(NO_JUMP);
+    state.jump_seq = seq;
+    // Called once the frame is consumed: the window's front is right at its end.
+    state.jump_ahead = 0;
 }
 
 /// Stores a stream's new count and counts the gap before it, if any.
@@ -792,6 +868,37 @@ mod tests {
         assert_eq!(out, vec![0, 1, 2, 4, 5]);
         assert_eq!(p.stats().gaps_of(Stream::Imu), 1);
         assert_eq!(p.stats().missed_of(Stream::Imu), 1);
+    }
+
+    #[test]
+    fn a_count_that_moved_on_is_followed_after_two_frames_agree() {
+        // Locked on IMU and encoder frames; then the IMU count moves on by 13 with no byte
+        // missing (frames lost upstream), while the encoder count keeps confirming the
+        // alignment. The first far IMU frame is taken as a damaged count byte, the second
+        // continues it and re-bases the count: no frame is lost.
+        let mut p = DownlinkParser::new();
+        let mut stream = Vec::new();
+        let mut enc = 0u8;
+        for seq in (1..=8u8).chain(21..=40) {
+            stream.extend_from_slice(&imu(seq, 3).encode());
+            if seq % 4 == 0 {
+                enc = enc.wrapping_add(1);
+                let ticks = [1, 2, 3, i16::from(enc)];
+                stream.extend_from_slice(&Encoders { ticks, seq: enc }.encode());
+            }
+        }
+        let mut out = feed(&mut p, &stream);
+        out.extend(core::iter::from_fn(|| p.idle()));
+        let imu_counts: Vec<u8> = out
+            .iter()
+            .filter(|f| f.kind() == Kind::Telemetry(Stream::Imu))
+            .filter_map(Telemetry::seq)
+            .collect();
+        let expected: Vec<u8> = (1..=8u8).chain(21..=40).collect();
+        assert_eq!(imu_counts, expected);
+        assert_eq!(p.lock(), Lock::Locked);
+        assert_eq!(p.stats().discarded, 0);
+        assert_eq!(p.stats().missed_of(Stream::Imu), 12);
     }
 
     #[test]

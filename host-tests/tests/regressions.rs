@@ -1,0 +1,35 @@
+//! Inputs the fuzz targets once failed on, kept so that they keep passing on stable `cargo test`.
+
+use chassis_host_tests::splice::{Splice, check_recovery};
+
+/// `spliced`, CI run of 2026-11-22: 28 bytes cut (the tail of one IMU frame, the whole next one
+/// and the start of a third), nothing put in. The IMU count then jumps by three where the bytes
+/// say one or two frames went missing; the parser kept rejecting every IMU frame as "far" until
+/// it forgot its counts, 13 frames later. Now two IMU frames whose counts continue each other
+/// re-base the count on an alignment another stream's count has confirmed.
+#[test]
+fn spliced_cut_of_two_imu_frames() {
+    let splice = Splice {
+        seed: 11_313_042_259_674_398_729,
+        at: 40_092,
+        cut: 156,
+        garbage: &[],
+    };
+    assert_eq!(check_recovery(&splice), Ok(()));
+}
+
+/// `spliced`, found by a longer local run the same day: 31 bytes cut early in the stream (an IMU
+/// frame's tail, a whole IMU frame and an encoder frame) and one zero byte put in. Both the IMU
+/// and the encoder counts jump, so no count continues while the parser hunts; it used to take
+/// every later IMU frame as "far" until it forgot its counts. Now an IMU frame that starts right
+/// where the rejected one ended, and continues its count, is taken even while hunting.
+#[test]
+fn spliced_cut_of_frames_of_both_streams() {
+    let splice = Splice {
+        seed: 18_445_336_698_838_018_409,
+        at: 0,
+        cut: 255,
+        garbage: &[0],
+    };
+    assert_eq!(check_recovery(&splice), Ok(()));
+}
