@@ -85,6 +85,15 @@ fn reference_parse(mut bytes: &[u8]) -> Option<Vec<Telemetry>> {
     Some(frames)
 }
 
+/// 512 cases per property, or `PROPTEST_CASES` when set (`cargo xtask test` fixes the seed with
+/// `PROPTEST_RNG_SEED`; without it every run draws new cases).
+fn cases() -> u32 {
+    std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(512)
+}
+
 fn parse_all(parser: &mut DownlinkParser, bytes: &[u8]) -> Vec<Telemetry> {
     let mut out: Vec<Telemetry> = parser.frames(bytes).collect();
     out.extend(std::iter::from_fn(|| parser.idle()));
@@ -92,7 +101,7 @@ fn parse_all(parser: &mut DownlinkParser, bytes: &[u8]) -> Vec<Telemetry> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 512, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: cases(), ..ProptestConfig::default() })]
 
     #[test]
     fn every_command_round_trips(command in command()) {
@@ -198,10 +207,10 @@ proptest! {
     /// On a clean stream from a frame boundary, the parser emits exactly what the reference does,
     /// unless the first frame is one that the parser, knowing no count yet, cannot tell from a
     /// false one (a battery frame, or a reply holding a telemetry header in its value): then it
-    /// starts as from any offset.
+    /// starts as from any offset (see the next property for what that guarantees).
     #[test]
     fn matches_the_reference_from_a_boundary(seed in any::<u64>(), frames in 1usize..300) {
-        let (bytes, _) = BoardStream::new(seed, 5.0).take(frames);
+        let (bytes, sent) = BoardStream::new(seed, 5.0).take(frames);
         let reference = reference_parse(&bytes).unwrap();
         let mut parser = DownlinkParser::new();
         let out = parse_all(&mut parser, &bytes);
@@ -212,14 +221,19 @@ proptest! {
         };
         if doubtful_first && out.first() != reference.first() {
             // The parser is then hunting inside that frame, as after any start mid-stream: no
-            // false frame once a real one came out, and every frame from the fourth on.
+            // false frame once a real one came out, and every frame that starts FORGET_AFTER + 30
+            // bytes in or later. (Most starts lose nothing after the first frame; proptest found
+            // a five-frame stream, a reply holding `FF FB` then an IMU frame whose gyro X is -4,
+            // that fooled the parser into four first-of-their-stream frames and so lost the
+            // fifth: with no count known, nothing tells it better.)
             let first_true = out.iter().position(|f| reference.contains(f)).unwrap_or(out.len());
             let mut order = reference.iter();
             for frame in &out[first_true..] {
                 prop_assert!(order.any(|f| f == frame), "false frame {:?}", frame);
             }
-            for frame in reference.iter().skip(3) {
-                prop_assert!(out.contains(frame), "lost {:?}", frame);
+            let bound = usize::from(FORGET_AFTER) + 30;
+            for f in sent.iter().filter(|f| f.start >= bound) {
+                prop_assert!(out.contains(&f.frame), "lost {:?}", f.frame);
             }
         } else {
             prop_assert_eq!(&out, &reference);
