@@ -239,8 +239,9 @@ enum Continuity {
     Continues,
     /// Not the next count of its stream, but the next count after the stream's last jump (see
     /// `State::jump_stream`): two frames in a row agree that the count has moved on (frames were
-    /// lost, a burst of bytes was dropped, the board restarted its count). Taken, when a header
-    /// follows, in every state; the stream's count is re-based on it.
+    /// lost, a burst of bytes was dropped, the board restarted its count). Taken when a header
+    /// follows (while hunting, only where the jump candidate ended); the stream's count is
+    /// re-based on it.
     ContinuesJump,
     /// Not the next count, but the stream's count is provisional: no evidence either way.
     Provisional,
