@@ -1,4 +1,5 @@
-//! A noisy UART: byte substitution, byte drop (overrun), byte insertion, and bursts of garbage,
+//! A noisy UART: byte substitution, byte drop (overrun), byte insertion, bursts of garbage and
+//! dropouts (runs of bytes lost: a USB-UART bridge or a busy receiver losing a whole buffer),
 //! each at its own rate per byte. It records where every received byte came from, so a score can
 //! tell a frame emitted at its place from a false one.
 
@@ -15,7 +16,9 @@ pub struct Noise {
     pub insert: f64,
     /// A burst starts here: this byte and the next `burst_len - 1` arrive as garbage.
     pub burst: f64,
-    /// Length of a burst in bytes.
+    /// A dropout starts here: this byte and the next `burst_len - 1` are lost.
+    pub dropout: f64,
+    /// Length of a burst or a dropout in bytes.
     pub burst_len: usize,
 }
 
@@ -34,6 +37,15 @@ impl Noise {
     pub fn bursts(rate: f64, len: usize) -> Self {
         Noise {
             burst: rate,
+            burst_len: len,
+            ..Noise::default()
+        }
+    }
+
+    /// Dropouts of `len` bytes lost in a row, starting at `rate` per byte.
+    pub fn dropouts(rate: f64, len: usize) -> Self {
+        Noise {
+            dropout: rate,
             burst_len: len,
             ..Noise::default()
         }
@@ -79,7 +91,18 @@ pub fn transmit(sent: &[u8], noise: &Noise, rng: &mut impl Rng) -> Received {
         kept: vec![true; sent.len()],
     };
     let mut burst_left = 0usize;
+    let mut dropout_left = 0usize;
     for (i, &byte) in sent.iter().enumerate() {
+        if dropout_left == 0 && noise.dropout > 0.0 && rng.random_bool(noise.dropout) {
+            dropout_left = noise.burst_len.max(1);
+            rx.errors += 1;
+        }
+        if dropout_left > 0 {
+            dropout_left -= 1;
+            rx.touched[i] = true;
+            rx.kept[i] = false;
+            continue;
+        }
         if burst_left == 0 && noise.burst > 0.0 && rng.random_bool(noise.burst) {
             burst_left = noise.burst_len.max(1);
             rx.errors += 1;
@@ -149,6 +172,27 @@ mod tests {
             .filter(|(b, o)| o.is_some() && **b != 0x55)
             .count();
         assert!(changed > 1500, "{changed}");
+    }
+
+    #[test]
+    fn a_dropout_loses_a_run_of_bytes_and_nothing_else() {
+        let sent: Vec<u8> = (0..100_000u32).map(|i| (i % 251) as u8).collect();
+        let rx = transmit(
+            &sent,
+            &Noise::dropouts(1e-3, 32),
+            &mut Pcg64Mcg::seed_from_u64(3),
+        );
+        assert!(rx.errors > 50 && rx.errors < 150, "{}", rx.errors);
+        assert_eq!(rx.bytes.len(), sent.len() - 32 * rx.errors);
+        // What arrives is sent bytes, unchanged and in order.
+        let mut last = None;
+        for (b, o) in rx.bytes.iter().zip(&rx.origin) {
+            let o = o.expect("a dropout inserts nothing");
+            assert_eq!(*b, sent[o]);
+            assert!(last < Some(o));
+            last = Some(o);
+        }
+        assert_eq!(rx.kept.iter().filter(|k| !**k).count(), 32 * rx.errors);
     }
 
     #[test]

@@ -115,6 +115,13 @@ fn main() -> ExitCode {
     for rate in [1e-4, 1e-3] {
         rows.push(("bursts of 8".to_string(), rate, Noise::bursts(rate, 8)));
     }
+    for rate in [1e-4, 1e-3] {
+        rows.push((
+            "dropouts of 32".to_string(),
+            rate,
+            Noise::dropouts(rate, 32),
+        ));
+    }
     for (name, rate, noise) in rows {
         let s = run(&noise, args.frames, args.seed);
         print_row(&name, rate, &s);
