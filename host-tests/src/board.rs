@@ -186,8 +186,17 @@ impl BoardStream {
 /// telemetry pauses (as the spec says it does during settings). Frame boundaries are found by
 /// decoding the clean output in order.
 pub fn simulator_stream(seed: u64, count: usize) -> (Vec<u8>, Vec<SentFrame>) {
+    let (bytes, frames, _) = simulator_bursts(seed, count);
+    (bytes, frames)
+}
+
+/// [`simulator_stream`], with where each burst of bytes ends: the board sends what falls due in
+/// one millisecond back to back, then the line is idle until the next frame is due (telemetry
+/// takes about 15 % of the line). Every burst ends on a frame boundary.
+pub fn simulator_bursts(seed: u64, count: usize) -> (Vec<u8>, Vec<SentFrame>, Vec<usize>) {
     use chassis_protocol::sim::{Board, SimConfig};
     use chassis_protocol::{Kind, Register, Setting};
+    let mut burst_ends = Vec::new();
     let mut board = Board::new(SimConfig {
         seed,
         ..SimConfig::default()
@@ -205,6 +214,9 @@ pub fn simulator_stream(seed: u64, count: usize) -> (Vec<u8>, Vec<SentFrame>) {
         board.advance(ms);
         let n = board.transmit(&mut buf);
         bytes.extend_from_slice(&buf[..n]);
+        if n > 0 {
+            burst_ends.push(bytes.len());
+        }
     }
     let mut frames = Vec::with_capacity(count);
     let mut at = 0;
@@ -225,7 +237,8 @@ pub fn simulator_stream(seed: u64, count: usize) -> (Vec<u8>, Vec<SentFrame>) {
         }
     }
     bytes.truncate(at);
-    (bytes, frames)
+    burst_ends.retain(|end| *end <= at);
+    (bytes, frames, burst_ends)
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@ pub mod splice;
 
 pub use board::{BoardStream, SentFrame};
 pub use channel::{Noise, Received};
-pub use score::{Score, Startup, score_downlink, startup};
+pub use score::{Score, Startup, score_downlink, startup, startup_with_idle};
 
 /// Cuts `bytes` into consecutive pieces whose lengths are taken from `lengths` in turn (each at
 /// least 1; the whole rest at once if `lengths` is empty): the reads a UART driver might see.

@@ -368,25 +368,40 @@ fn a_truncated_frame_in_mid_stream_is_recovered_from_within_a_bound() {
 }
 
 #[test]
-fn a_reply_on_a_quiet_line_comes_out_on_idle_or_at_once_when_aligned() {
-    // The board stops telemetry while settings are made (A6): a reply alone on the line.
+fn a_reply_after_a_quiet_line_comes_out_at_once_and_a_false_battery_at_one_does_not() {
+    // The board stops telemetry while settings are made (A6): the line goes quiet, then a reply
+    // comes alone. The quiet line is a frame boundary: the reply comes out on its last byte.
     let reply = [0x23u8, 0x0B, 0x00, 0x00, 0x04, 0xB0];
+    let expected = Telemetry::Reply(Reply {
+        code: 0x0B,
+        value: 1200,
+    });
     let mut parser = DownlinkParser::new();
-    assert_eq!(parser.frames(&reply).count(), 0);
-    assert_eq!(
-        parser.idle(),
-        Some(Telemetry::Reply(Reply {
-            code: 0x0B,
-            value: 1200
-        }))
-    );
-    // The quiet line is a frame boundary: the next reply comes out on its last byte.
+    assert_eq!(parser.idle(), None);
     let got: Vec<Telemetry> = parser.frames(&reply).collect();
-    assert_eq!(
-        got,
-        vec![Telemetry::Reply(Reply {
-            code: 0x0B,
-            value: 1200
-        })]
-    );
+    assert_eq!(got, vec![expected]);
+    assert_eq!(parser.idle(), None);
+    let got: Vec<Telemetry> = parser.frames(&reply).collect();
+    assert_eq!(got, vec![expected]);
+
+    // A parser that saw no quiet line before it cannot tell a battery frame from the tail of an
+    // IMU frame it started listening in: a gyro X of -4 writes `FF FC` at byte 8, and the false
+    // battery frame from there ends on the IMU frame's last byte, where the line goes quiet.
+    // Hunting, a battery frame that only a quiet line delimits is not taken.
+    let mut imu = [
+        0xFF, 0xFA, 0x00, 0x01, 0x00, 0x02, 0x40, 0x00, 0xFF, 0xFC, 0x00, 0x03, 0x00, 0x01, 0x2A,
+    ];
+    let mut parser = DownlinkParser::new();
+    assert_eq!(parser.frames(&imu[3..]).count(), 0);
+    assert_eq!(parser.idle(), None);
+    assert_eq!(parser.stats().discarded, 12);
+    // The same bytes from the frame's start, after a quiet line: the IMU frame, nothing else.
+    assert_eq!(parser.frames(&imu).count(), 0);
+    match parser.idle() {
+        Some(Telemetry::Imu(got)) => assert_eq!((got.gyro, got.seq), ([-4, 3, 1], 0x2A)),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(parser.idle(), None);
+    imu[14] = 0x2B;
+    assert_eq!(parser.frames(&imu).count(), 1);
 }
