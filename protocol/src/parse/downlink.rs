@@ -401,8 +401,10 @@ impl DownlinkParser {
     /// loop until it returns `None`.
     ///
     /// A complete frame waiting for the next header is judged as if one had come (silence is a
-    /// frame boundary); an incomplete one is thrown away. With the window empty, the next byte
-    /// is taken to start a frame (the parser becomes at least *Tentative*). UART peripherals
+    /// frame boundary; but while hunting, not proof enough of a battery frame with no count to
+    /// go by: see the [module docs](self)); an incomplete one is thrown away. With the window
+    /// empty, the next byte is taken to start a frame (the parser becomes at least
+    /// *Tentative*). UART peripherals
     /// with an idle-line interrupt make this free; without one, call it from a timeout.
     pub fn idle(&mut self) -> Option<Telemetry> {
         loop {
