@@ -165,22 +165,12 @@ pub struct Startup {
 /// Starts a new parser at every offset of the first three frames of `seeds` clean streams of
 /// `frames` frames, and counts what the starts cost.
 pub fn startup(seeds: std::ops::Range<u64>, frames: usize) -> Startup {
-    let mut figures = Startup::default();
-    for seed in seeds {
+    starts(seeds.map(|seed| {
         let (bytes, sent) = crate::BoardStream::new(seed, 2.0).take(frames.max(4));
-        for offset in 0..sent[3].start {
-            let first = sent
-                .iter()
-                .position(|f| f.start >= offset)
-                .unwrap_or(sent.len());
-            let mut parser = DownlinkParser::new();
-            let mut out: Vec<Telemetry> = parser.frames(&bytes[offset..]).collect();
-            out.extend(std::iter::from_fn(|| parser.idle()));
-            let expected: Vec<Telemetry> = sent[first..].iter().map(|f| f.frame).collect();
-            figures.add_start(&out, &expected);
-        }
-    }
-    figures
+        // Back to back: the line goes quiet only at the end.
+        let ends = vec![bytes.len()];
+        (bytes, sent, ends)
+    }))
 }
 
 /// [`startup`] over the board simulator's output with the line going quiet between the bursts
@@ -188,10 +178,18 @@ pub fn startup(seeds: std::ops::Range<u64>, frames: usize) -> Startup {
 /// driver does after 2 ms without a byte): every offset of the first three frames of `seeds`
 /// streams of `frames` frames.
 pub fn startup_with_idle(seeds: std::ops::Range<u64>, frames: usize) -> Startup {
+    starts(seeds.map(|seed| crate::board::simulator_bursts(seed, frames.max(4))))
+}
+
+/// Every start offset in the first three frames of each stream (bytes, frames sent, where the
+/// line goes quiet), the parser told of each quiet line with `idle()`.
+fn starts(streams: impl Iterator<Item = (Vec<u8>, Vec<SentFrame>, Vec<usize>)>) -> Startup {
     let mut figures = Startup::default();
-    for seed in seeds {
-        let (bytes, sent, burst_ends) = crate::board::simulator_bursts(seed, frames.max(4));
-        for offset in 0..sent[3].start {
+    for (bytes, sent, quiet_at) in streams {
+        let Some(third) = sent.get(3) else {
+            continue;
+        };
+        for offset in 0..third.start {
             let first = sent
                 .iter()
                 .position(|f| f.start >= offset)
@@ -199,7 +197,7 @@ pub fn startup_with_idle(seeds: std::ops::Range<u64>, frames: usize) -> Startup 
             let mut parser = DownlinkParser::new();
             let mut out: Vec<Telemetry> = Vec::new();
             let mut from = offset;
-            for &end in burst_ends.iter().filter(|end| **end > offset) {
+            for &end in quiet_at.iter().filter(|end| **end > offset) {
                 out.extend(parser.frames(&bytes[from..end]));
                 out.extend(std::iter::from_fn(|| parser.idle()));
                 from = end;
