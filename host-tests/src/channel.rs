@@ -90,29 +90,29 @@ pub fn transmit(sent: &[u8], noise: &Noise, rng: &mut impl Rng) -> Received {
         errors: 0,
         kept: vec![true; sent.len()],
     };
-    let mut burst_left = 0usize;
-    let mut dropout_left = 0usize;
+    // The bytes left in the current dropout or burst, and whether they are lost (a dropout) or
+    // turned into garbage (a burst).
+    let mut run_left = 0usize;
+    let mut run_lost = false;
     for (i, &byte) in sent.iter().enumerate() {
-        if dropout_left == 0 && noise.dropout > 0.0 && rng.random_bool(noise.dropout) {
-            dropout_left = noise.burst_len.max(1);
-            rx.errors += 1;
+        if run_left == 0 {
+            for (rate, lost) in [(noise.dropout, true), (noise.burst, false)] {
+                if rate > 0.0 && rng.random_bool(rate) {
+                    run_left = noise.burst_len.max(1);
+                    run_lost = lost;
+                    rx.errors += 1;
+                    break;
+                }
+            }
         }
-        if dropout_left > 0 {
-            dropout_left -= 1;
+        if run_left > 0 {
+            run_left -= 1;
             rx.touched[i] = true;
             rx.kept[i] = false;
-            continue;
-        }
-        if burst_left == 0 && noise.burst > 0.0 && rng.random_bool(noise.burst) {
-            burst_left = noise.burst_len.max(1);
-            rx.errors += 1;
-        }
-        if burst_left > 0 {
-            burst_left -= 1;
-            rx.touched[i] = true;
-            rx.kept[i] = false;
-            rx.bytes.push(rng.random());
-            rx.origin.push(Some(i));
+            if !run_lost {
+                rx.bytes.push(rng.random());
+                rx.origin.push(Some(i));
+            }
             continue;
         }
         if noise.insert > 0.0 && rng.random_bool(noise.insert) {
