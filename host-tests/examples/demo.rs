@@ -3,7 +3,7 @@
 
 use chassis_host_tests::channel::{Noise, transmit};
 use chassis_host_tests::{BoardStream, score_downlink};
-use chassis_protocol::driver::{Config, Error, blocking::Driver};
+use chassis_protocol::driver::{Config, CoreError, Error, blocking::Driver};
 use chassis_protocol::sim::{Board, SimClock, SimConfig, SimUart};
 use chassis_protocol::{
     Action, DownlinkParser, DriveType, Motors, Register, Setting, SystemMode, Telemetry, Turn,
@@ -102,7 +102,7 @@ fn drive_the_simulator() -> Result<(), Error<core::convert::Infallible>> {
     // A 100 Hz loop that asks for a 90-degree turn every period, as a naive master would.
     let mut refused = 0;
     for _ in 0..100 {
-        if let Err(Error::TurnInProgress) = driver.turn_by(900) {
+        if let Err(Error::Core(CoreError::TurnInProgress)) = driver.turn_by(900) {
             refused += 1;
         }
         let until = time.get() + 10;

@@ -2,7 +2,7 @@
 //! clock (1 ms per clock reading): every command, every setting written and read back, the
 //! one-shot turn, the failsafe, the reply timeout, telemetry rates, the settings snapshot.
 
-use chassis_protocol::driver::{Config, Error, Event, Settings, blocking::Driver};
+use chassis_protocol::driver::{Config, CoreError, Error, Event, Settings, blocking::Driver, reg};
 use chassis_protocol::sim::{Board, FACTORY, Faults, Motion, SimClock, SimConfig, SimUart};
 use chassis_protocol::{
     Action, DriveType, Motors, Register, Stream, SystemMode, Telemetry, Velocity, Write,
@@ -93,8 +93,8 @@ fn every_register_written_reads_back() {
     ];
     for write in writes {
         d.write(write).unwrap();
-        let reply = d.read_register(write.register()).unwrap();
-        assert_eq!(reply.as_write(), Some(write), "{write:?}");
+        let raw = d.read_raw(write.register()).unwrap();
+        assert_eq!(raw, write.value(), "{write:?}");
     }
 }
 
@@ -109,36 +109,17 @@ fn actions_store_load_and_defaults() {
     .unwrap();
     d.action(Action::Store).unwrap();
     d.action(Action::LoadDefaults).unwrap();
-    assert_eq!(
-        d.read_register(Register::MaxSpeed).unwrap().value,
-        u32::from(FACTORY.max_speed)
-    );
+    assert_eq!(d.read(reg::MaxSpeed).unwrap(), FACTORY.max_speed);
     d.action(Action::LoadStored).unwrap();
-    assert_eq!(d.read_register(Register::MaxSpeed).unwrap().value, 42);
+    assert_eq!(d.read(reg::MaxSpeed).unwrap(), 42);
     // System-mode bit 3 (gyro compensation) is not stored.
-    let mode = d
-        .read_register(Register::SystemMode)
-        .unwrap()
-        .system_mode()
-        .unwrap();
+    let mode = d.read(reg::SystemMode).unwrap();
     assert_eq!(mode.drive_type(), DriveType::Omni);
     assert!(!mode.gyro_compensation());
     d.action(Action::GyroCompensationOn).unwrap();
-    assert!(
-        d.read_register(Register::SystemMode)
-            .unwrap()
-            .system_mode()
-            .unwrap()
-            .gyro_compensation()
-    );
+    assert!(d.read(reg::SystemMode).unwrap().gyro_compensation());
     d.action(Action::GyroCompensationOff).unwrap();
-    assert!(
-        !d.read_register(Register::SystemMode)
-            .unwrap()
-            .system_mode()
-            .unwrap()
-            .gyro_compensation()
-    );
+    assert!(!d.read(reg::SystemMode).unwrap().gyro_compensation());
 }
 
 #[test]
@@ -147,20 +128,11 @@ fn gyro_calibration_takes_thirty_seconds() {
     let mut d = driver(&time);
     d.action(Action::RecalibrateGyro).unwrap();
     run_for(&mut d, &time, 1_000);
-    assert_eq!(
-        d.read_register(Register::GyroCalibration).unwrap().value,
-        0xFFFF
-    );
+    assert_eq!(d.read(reg::GyroCalibration).unwrap(), 0xFFFF);
     run_for(&mut d, &time, 28_000);
-    assert_eq!(
-        d.read_register(Register::GyroCalibration).unwrap().value,
-        0xFFFF
-    );
+    assert_eq!(d.read(reg::GyroCalibration).unwrap(), 0xFFFF);
     run_for(&mut d, &time, 1_100);
-    assert_ne!(
-        d.read_register(Register::GyroCalibration).unwrap().value,
-        0xFFFF
-    );
+    assert_ne!(d.read(reg::GyroCalibration).unwrap(), 0xFFFF);
 }
 
 #[test]
@@ -172,7 +144,7 @@ fn a_turn_in_a_periodic_loop_is_sent_once() {
     for _ in 0..50 {
         match d.turn_by(900) {
             Ok(()) => {}
-            Err(Error::TurnInProgress) => refused += 1,
+            Err(Error::Core(CoreError::TurnInProgress)) => refused += 1,
             Err(e) => panic!("{e:?}"),
         }
         run_for(&mut d, &time, 10);
@@ -185,7 +157,7 @@ fn a_turn_in_a_periodic_loop_is_sent_once() {
     d.turn_by(-450).unwrap();
     run_for(&mut d, &time, 10);
     assert_eq!(d.uart().board().total_turn_commanded(), 450);
-    assert_eq!(d.turn_by(-450), Err(Error::TurnInProgress));
+    assert_eq!(d.turn_by(-450), Err(Error::Core(CoreError::TurnInProgress)));
 }
 
 #[test]
@@ -229,8 +201,10 @@ fn a_silent_board_gives_a_reply_timeout() {
     });
     let start = time.get();
     assert_eq!(
-        d.read_register(Register::SpeedKp),
-        Err(Error::<Infallible>::Timeout(Register::SpeedKp))
+        d.read(reg::SpeedKp),
+        Err(Error::<Infallible>::Core(CoreError::Timeout(
+            Register::SpeedKp
+        )))
     );
     let waited = time.get() - start;
     let timeout = u64::from(Config::DEFAULT.reply_timeout_ms());
@@ -240,10 +214,7 @@ fn a_silent_board_gives_a_reply_timeout() {
     );
     // The driver is free again.
     d.uart_mut().board_mut().set_faults(Faults::default());
-    assert_eq!(
-        d.read_register(Register::MotorVoltage).unwrap().value,
-        1_200
-    );
+    assert_eq!(d.read(reg::MotorVoltage).unwrap(), 1_200);
 }
 
 #[test]
@@ -293,8 +264,8 @@ fn replies_interleave_with_telemetry_on_a_noisy_line() {
     // unseen; a verified read (two replies that agree) does not.
     let mut ok = 0;
     for _ in 0..200 {
-        if let Ok(reply) = d.read_register_verified(Register::MotorVoltage) {
-            assert_eq!(reply.value, 1_200);
+        if let Ok(centivolts) = d.read_verified(reg::MotorVoltage) {
+            assert_eq!(centivolts, 1_200);
             ok += 1;
         }
         run_for(&mut d, &time, 20);

@@ -105,8 +105,8 @@ proptest! {
 
     #[test]
     fn every_command_round_trips(command in command()) {
-        let bytes = command.encode();
-        prop_assert_eq!(Command::decode(&bytes), Ok(command));
+        let bytes = command.clone().encode();
+        prop_assert_eq!(Command::decode(&bytes), Ok(command.clone()));
         // And through the uplink parser, on its last byte.
         let mut parser = UplinkParser::new();
         let (last, body) = bytes.split_last().unwrap();
@@ -188,7 +188,7 @@ proptest! {
     ) {
         let mut bytes = noise.clone();
         for command in &commands {
-            bytes.extend_from_slice(&command.encode());
+            bytes.extend_from_slice(&command.clone().encode());
         }
         let mut one = UplinkParser::new();
         let expected: Vec<Command> = bytes.iter().filter_map(|b| one.push(*b)).collect();

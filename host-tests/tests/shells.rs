@@ -6,7 +6,7 @@ use chassis_protocol::driver::asynch::Driver as AsyncDriver;
 use chassis_protocol::driver::blocking::Driver;
 use chassis_protocol::driver::io06::Io06;
 use chassis_protocol::driver::nb::NbSerial;
-use chassis_protocol::driver::{Config, Error};
+use chassis_protocol::driver::{Config, CoreError, Error, reg};
 use chassis_protocol::sim::{Board, Faults, Motion, SimClock, SimConfig, SimDelay, SimUart};
 use chassis_protocol::{Register, Velocity, Write};
 use core::cell::Cell;
@@ -52,9 +52,9 @@ fn nb_shell_drives_the_board() {
     let mut d = Driver::new(NbSerial::new(port), SimClock(&time), Config::DEFAULT);
     d.set_velocity(Velocity::new(0, 120, -5)).unwrap();
     d.write(Write::MaxSpeed(777)).unwrap();
-    assert_eq!(d.read_register(Register::MaxSpeed).unwrap().value, 777);
+    assert_eq!(d.read(reg::MaxSpeed).unwrap(), 777);
     d.turn_by(900).unwrap();
-    assert_eq!(d.turn_by(900), Err(Error::TurnInProgress));
+    assert_eq!(d.turn_by(900), Err(Error::Core(CoreError::TurnInProgress)));
     let end = time.get() + 500;
     while time.get() < end {
         d.poll().unwrap();
@@ -72,15 +72,15 @@ fn async_shell_drives_the_board() {
     let mut d = AsyncDriver::new(uart, SimClock(&time), SimDelay(&time), Config::DEFAULT);
     embassy_futures::block_on(async {
         d.set_velocity(Velocity::new(10, 20, 30)).await.unwrap();
-        assert_eq!(
-            d.read_register(Register::MotorVoltage).await.unwrap().value,
-            1_200
-        );
+        assert_eq!(d.read(reg::MotorVoltage).await.unwrap(), 1_200);
         d.write(Write::SpeedKi(31)).await.unwrap();
         let settings = d.read_settings().await.unwrap();
         assert_eq!(settings.speed_ki, 31);
         d.turn_by(-300).await.unwrap();
-        assert_eq!(d.turn_by(-300).await, Err(Error::TurnInProgress));
+        assert_eq!(
+            d.turn_by(-300).await,
+            Err(Error::Core(CoreError::TurnInProgress))
+        );
         while d.turn_remaining().await.unwrap() != 0 {}
         d.turn_by(-300).await.unwrap();
     });
@@ -102,8 +102,11 @@ fn async_shell_times_out_on_a_silent_board() {
     });
     let uart = SimUart::new(board, &time);
     let mut d = AsyncDriver::new(uart, SimClock(&time), SimDelay(&time), Config::DEFAULT);
-    let result = embassy_futures::block_on(d.read_register(Register::SpeedKp));
-    assert_eq!(result, Err(Error::Timeout(Register::SpeedKp)));
+    let result = embassy_futures::block_on(d.read(reg::SpeedKp));
+    assert_eq!(
+        result,
+        Err(Error::Core(CoreError::Timeout(Register::SpeedKp)))
+    );
     let waited = time.get();
     let timeout = u64::from(Config::DEFAULT.reply_timeout_ms());
     assert!((timeout..timeout + 5).contains(&waited), "{waited} ms");
@@ -144,7 +147,7 @@ fn embedded_io_06_uarts_work_through_the_adapter() {
     let uart = Uart06(SimUart::new(Board::new(SimConfig::default()), &time));
     let mut d = Driver::new(Io06(uart), SimClock(&time), Config::DEFAULT);
     d.write(Write::GyroGain(4_242)).unwrap();
-    assert_eq!(d.read_register(Register::GyroGain).unwrap().value, 4_242);
+    assert_eq!(d.read(reg::GyroGain).unwrap(), 4_242);
     d.set_velocity(Velocity::new(1, 2, 3)).unwrap();
     let (Io06(uart), _) = d.release();
     assert_eq!(

@@ -157,7 +157,7 @@ mod tests {
             let (Ok(c), Ok(t)) = (Command::arbitrary(&mut u), Telemetry::arbitrary(&mut u)) else {
                 break;
             };
-            assert_eq!(Command::decode(&c.encode()), Ok(c));
+            assert_eq!(Command::decode(&c.clone().encode()), Ok(c));
             assert_eq!(Telemetry::decode(&t.encode()), Ok(t));
             made += 1;
         }

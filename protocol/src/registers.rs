@@ -31,7 +31,8 @@ pub struct Settings {
 }
 
 impl Settings {
-    /// The registers a snapshot holds, in the order [`Settings::writes`] gives them.
+    /// The eight registers a snapshot holds. [`Settings::writes`] gives seven of them back, in
+    /// this order, leaving out the gyro calibration value.
     pub const REGISTERS: [Register; 8] = [
         Register::MaxSpeed,
         Register::SpeedKp,
@@ -113,5 +114,142 @@ impl Settings {
                 cutoff_centivolts: self.battery_cutoff_centivolts,
             },
         ]
+    }
+}
+
+/// The battery voltage range register (`0x0C`): two values in 0.01 V; `0x7FFF` in either means
+/// the board's built-in table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct BatteryRange {
+    /// A full battery, in 0.01 V (the reply's high half).
+    pub full_centivolts: u16,
+    /// The cut-off, in 0.01 V (the reply's low half).
+    pub cutoff_centivolts: u16,
+}
+
+/// A register whose reply has a type of its own: what [`reg`]'s marker types implement, so that
+/// reading a register gives its value typed (max speed a `u16`, the system mode a
+/// [`SystemMode`], the pending angle signed 0.1°), and a reply whose value does not fit the
+/// register is an error instead of a wrong value.
+pub trait Readable {
+    /// The register read.
+    const REGISTER: Register;
+    /// Its value's type.
+    type Value: Copy + core::fmt::Debug + PartialEq;
+    /// The value a reply carries, `None` if it does not fit this register (a 16-bit register
+    /// with bits in its high half: a damaged reply).
+    fn from_raw(raw: u32) -> Option<Self::Value>;
+}
+
+/// Marker types of the readable registers, for typed reads (`driver.read(reg::MaxSpeed)`).
+pub mod reg {
+    use super::Readable;
+    use crate::command::Register;
+
+    macro_rules! readable {
+        ($(#[$doc:meta])* $name:ident, $value:ty, |$raw:ident| $convert:expr) => {
+            $(#[$doc])*
+            #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+            pub struct $name;
+
+            impl Readable for $name {
+                const REGISTER: Register = Register::$name;
+                type Value = $value;
+                fn from_raw($raw: u32) -> Option<$value> {
+                    $convert
+                }
+            }
+        };
+    }
+
+    readable!(
+        /// `0x01`: maximum speed limit, `u16` (unit not stated, A8).
+        MaxSpeed, u16, |raw| u16::try_from(raw).ok()
+    );
+    readable!(
+        /// `0x06`: speed-loop KP, raw `u32`.
+        SpeedKp, u32, |raw| Some(raw)
+    );
+    readable!(
+        /// `0x07`: speed-loop KI, raw `u32`.
+        SpeedKi, u32, |raw| Some(raw)
+    );
+    readable!(
+        /// `0x08`: gyro compensation gain, `u32` in 0.00001.
+        GyroGain, u32, |raw| Some(raw)
+    );
+    readable!(
+        /// `0x09`: the system mode bit field (every bit kept).
+        SystemMode, crate::command::SystemMode, |raw| Some(
+            crate::command::SystemMode::from_bits(raw)
+        )
+    );
+    readable!(
+        /// `0x0A`: gyro calibration value, `u16` (0xFFFF while a calibration runs).
+        GyroCalibration, u16, |raw| u16::try_from(raw).ok()
+    );
+    readable!(
+        /// `0x0B`: motor output voltage, `u16` in 0.01 V.
+        MotorVoltage, u16, |raw| u16::try_from(raw).ok()
+    );
+    readable!(
+        /// `0x0C`: the battery voltage range.
+        BatteryRange, super::BatteryRange, |raw| Some(super::BatteryRange {
+            full_centivolts: (raw >> 16) as u16,
+            cutoff_centivolts: (raw & 0xFFFF) as u16,
+        })
+    );
+    readable!(
+        /// `0x20`: the angle still to turn, signed, in 0.1° (the reply's `u32` read as `i32`).
+        PendingAngle, i32, |raw| Some(raw as i32)
+    );
+}
+
+/// Whether `raw` fits `register` (16-bit registers need their high half at 0).
+#[must_use]
+pub const fn fits(register: Register, raw: u32) -> bool {
+    match register {
+        Register::MaxSpeed | Register::GyroCalibration | Register::MotorVoltage => raw >> 16 == 0,
+        _ => true,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sixteen_bit_registers_refuse_a_high_half() {
+        assert_eq!(
+            <reg::MaxSpeed as Readable>::from_raw(0x0000_03E8),
+            Some(1_000)
+        );
+        assert_eq!(<reg::MaxSpeed as Readable>::from_raw(0x0001_0000), None);
+        assert_eq!(<reg::MotorVoltage as Readable>::from_raw(0x0100_04B0), None);
+        assert!(!fits(Register::GyroCalibration, 0x0001_FFFF));
+        assert!(fits(Register::SpeedKp, u32::MAX));
+    }
+
+    #[test]
+    fn the_pending_angle_is_signed_and_the_battery_range_split() {
+        assert_eq!(
+            <reg::PendingAngle as Readable>::from_raw(0xFFFF_FC7C),
+            Some(-900)
+        );
+        assert_eq!(
+            <reg::BatteryRange as Readable>::from_raw(0x04EC_041A),
+            Some(BatteryRange {
+                full_centivolts: 1_260,
+                cutoff_centivolts: 1_050
+            })
+        );
+    }
+
+    #[test]
+    fn the_snapshot_lists_its_eight_registers_and_writes_seven() {
+        assert_eq!(Settings::REGISTERS.len(), 8);
+        assert_eq!(Settings::default().writes().len(), 7);
     }
 }

@@ -124,8 +124,8 @@ pub enum Motion {
 
 /// Gyro calibration time: 10 s settle + 20 s still.
 const CALIBRATION_MS: u64 = 30_000;
-/// Turning speed in angle mode, 0.1° per ms (90°/s).
-const TURN_DECI_DEGREES_PER_MS: i64 = 9;
+/// Turning speed in angle mode: 9 × 0.1° every 10 ms, 90°/s.
+const TURN_DECI_DEGREES_PER_10_MS: i64 = 9;
 /// Telemetry periods in ms: IMU, encoders, battery.
 const PERIODS_MS: [u64; 3] = [10, 40, 1_000];
 
@@ -479,11 +479,14 @@ impl Board {
             *ticks = ticks.wrapping_add(whole as i16);
         }
         if self.pending_deci_degrees != 0 {
-            let step = self
+            // The rate (0.1° per 10 ms) goes to the gyro every ms; the angle moves on every 10.
+            let rate = self
                 .pending_deci_degrees
-                .clamp(-TURN_DECI_DEGREES_PER_MS, TURN_DECI_DEGREES_PER_MS);
-            self.pending_deci_degrees = self.pending_deci_degrees.saturating_sub(step);
-            self.turn_carry = step;
+                .clamp(-TURN_DECI_DEGREES_PER_10_MS, TURN_DECI_DEGREES_PER_10_MS);
+            if self.now_ms.checked_rem(10) == Some(0) {
+                self.pending_deci_degrees = self.pending_deci_degrees.saturating_sub(rate);
+            }
+            self.turn_carry = rate;
         } else {
             self.turn_carry = 0;
         }
@@ -509,7 +512,7 @@ impl Board {
                     Motion::Velocity { z, .. } => z,
                     Motion::Motors(_) => 0,
                 };
-                let turning = clamp_i32(self.turn_carry.saturating_mul(100));
+                let turning = clamp_i32(self.turn_carry.saturating_mul(10));
                 let gyro_z = rotation.saturating_add(turning).clamp(-32_768, 32_767) as i16;
                 Telemetry::Imu(Imu {
                     accel: [
@@ -583,13 +586,26 @@ impl Board {
 pub struct SimUart<'t> {
     board: Board,
     time: &'t core::cell::Cell<u64>,
+    burst_ms: u64,
 }
 
 #[cfg(feature = "driver")]
 impl<'t> SimUart<'t> {
     /// `board` behind a UART, on the clock `time`.
     pub fn new(board: Board, time: &'t core::cell::Cell<u64>) -> Self {
-        SimUart { board, time }
+        SimUart {
+            board,
+            time,
+            burst_ms: 1,
+        }
+    }
+
+    /// Hands the board's bytes over only every `burst_ms` ms, all at once, as a USB-UART
+    /// adapter does (its latency timer: 1 to 16 ms): a frame is often cut across two bursts.
+    #[must_use]
+    pub fn with_bursts(mut self, burst_ms: u64) -> Self {
+        self.burst_ms = burst_ms.max(1);
+        self
     }
 
     /// The board (to inspect it in a test).
@@ -603,7 +619,9 @@ impl<'t> SimUart<'t> {
     }
 
     fn catch_up(&mut self) {
-        self.board.advance(self.time.get());
+        let now = self.time.get();
+        let burst = now.checked_rem(self.burst_ms).unwrap_or(0);
+        self.board.advance(now.saturating_sub(burst));
     }
 }
 
@@ -641,10 +659,16 @@ impl embedded_io::Write for SimUart<'_> {
     }
 }
 
+/// Waits (yields to the executor) until a byte is there, as a real UART's read does.
 #[cfg(feature = "async")]
 impl embedded_io_async::Read for SimUart<'_> {
     async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Self::Error> {
-        embedded_io::Read::read(self, buf)
+        loop {
+            if embedded_io::ReadReady::read_ready(self)? || buf.is_empty() {
+                return embedded_io::Read::read(self, buf);
+            }
+            embassy_futures::yield_now().await;
+        }
     }
 }
 

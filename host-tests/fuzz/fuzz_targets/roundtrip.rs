@@ -8,8 +8,8 @@ use libfuzzer_sys::fuzz_target;
 fuzz_target!(|frames: (Command, Telemetry)| {
     let (command, telemetry) = frames;
 
-    let bytes = command.encode();
-    assert_eq!(Command::decode(&bytes), Ok(command));
+    let bytes = command.clone().encode();
+    assert_eq!(Command::decode(&bytes), Ok(command.clone()));
     let mut uplink = UplinkParser::new();
     let out: Vec<Command> = uplink.frames(&bytes).collect();
     assert_eq!(out, [command]);

@@ -37,7 +37,7 @@ fn seeds(dir: &Path) -> std::io::Result<usize> {
         ];
         let mut uplink: Vec<u8> = Vec::new();
         for command in &commands {
-            uplink.extend_from_slice(&command.encode());
+            uplink.extend_from_slice(&command.clone().encode());
         }
         write(dir, "uplink", written, &uplink)?;
         write(dir, "roundtrip", written, &uplink[..uplink.len().min(24)])?;

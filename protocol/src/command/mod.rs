@@ -57,11 +57,12 @@ pub const fn frame_len(mode: u8) -> Option<usize> {
 /// use chassis_protocol::{Command, Velocity};
 ///
 /// let command = Command::Velocity(Velocity::new(0, 100, 0));
-/// let bytes = command.encode();
+/// let bytes = command.clone().encode(); // encoding consumes a command (it may be a turn)
 /// assert_eq!(bytes.len(), 10);
 /// assert_eq!(Command::decode(bytes.as_slice()), Ok(command));
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+// Not `Copy`, like the [`Turn`] it may hold.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Command {
@@ -92,9 +93,9 @@ impl Command {
         false
     }
 
-    /// The frame's bytes.
+    /// The frame's bytes. Consumes the command, as [`Turn::encode`] does.
     #[must_use]
-    pub fn encode(&self) -> CommandBytes {
+    pub fn encode(self) -> CommandBytes {
         match self {
             Command::Velocity(v) => CommandBytes::new(&v.encode()),
             Command::Turn(t) => CommandBytes::new(&t.encode()),
@@ -201,8 +202,9 @@ mod tests {
             (Command::from(Setting::Read(Register::SpeedKp)), 10),
         ] {
             assert_eq!(command.len(), len);
-            assert_eq!(command.encode().len(), len);
-            assert_eq!(Command::decode(&command.encode()), Ok(command));
+            let bytes = command.clone().encode();
+            assert_eq!(bytes.len(), len);
+            assert_eq!(Command::decode(&bytes), Ok(command));
         }
     }
 }

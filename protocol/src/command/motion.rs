@@ -130,7 +130,10 @@ pub struct Velocity {
     pub y: i32,
     /// Z: rotation speed; positive is the board's "forward" rotation (dir bit 0 clear).
     pub z: i32,
-    /// Reserved direction bits and reverse bits of zero magnitudes, kept from `decode`.
+    /// Reserved direction bits and reverse bits of zero magnitudes, kept from `decode`. Never
+    /// serialised: a value that comes through serde carries none, so no message can set a bit
+    /// (such as the angle-mode bit) that the typed fields do not show.
+    #[cfg_attr(feature = "serde", serde(skip))]
     kept: u8,
 }
 
@@ -166,7 +169,8 @@ impl Velocity {
     /// The 10 bytes of this frame. Each axis saturates at ±65 535.
     #[must_use]
     pub fn encode(&self) -> [u8; Self::LEN] {
-        encode_body(self.x, self.y, self.z, self.kept)
+        // Never the angle-mode bit, however the value was made: a `Velocity` is safe to repeat.
+        encode_body(self.x, self.y, self.z, self.kept & !dir::ANGLE_MODE)
     }
 
     /// Decodes exactly one frame. An angle-mode frame is [`Error::Mode`]: decode it as a
@@ -263,7 +267,9 @@ pub enum VelocityReading {
 /// let frame = Turn::by_deci_degrees(-900).encode();
 /// assert_eq!(frame, [0xFF, 0xFE, 0x01, 0x00, 0x00, 0x00, 0x00, 0x03, 0x84, 0b0001_0001]);
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+// Not `Copy`: sending a turn consumes it ([`Turn::encode`] takes `self`), so one value cannot be
+// sent twice by accident; a second turn is a second value (or an explicit `clone`).
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Turn {
@@ -273,7 +279,10 @@ pub struct Turn {
     pub y: i32,
     /// The angle to add to the pending turn, in 0.1° (±65 535, saturated).
     pub deci_degrees: i32,
-    /// Reserved direction bits and reverse bits of zero magnitudes, kept from `decode`.
+    /// Reserved direction bits and reverse bits of zero magnitudes, kept from `decode`. Never
+    /// serialised: a value that comes through serde carries none, so no message can set a bit
+    /// (such as the angle-mode bit) that the typed fields do not show.
+    #[cfg_attr(feature = "serde", serde(skip))]
     kept: u8,
 }
 
@@ -298,9 +307,10 @@ impl Turn {
         }
     }
 
-    /// The 10 bytes of this frame (angle-mode bit set).
+    /// The 10 bytes of this frame (angle-mode bit set). Consumes the turn: the board adds every
+    /// angle frame it receives to the pending turn, so a `Turn` is encoded (sent) once.
     #[must_use]
-    pub fn encode(&self) -> [u8; Self::LEN] {
+    pub fn encode(self) -> [u8; Self::LEN] {
         encode_body(
             self.x,
             self.y,
@@ -367,7 +377,10 @@ pub struct Motors {
     pub control: MotorLoop,
     /// MOTO1..MOTO4, signed (±65 535, saturated).
     pub values: [i32; 4],
-    /// Reserved direction bits and reverse bits of zero magnitudes, kept from `decode`.
+    /// Reserved direction bits and reverse bits of zero magnitudes, kept from `decode`. Never
+    /// serialised: a value that comes through serde carries none, so no message can set a bit
+    /// (such as the angle-mode bit) that the typed fields do not show.
+    #[cfg_attr(feature = "serde", serde(skip))]
     kept: u8,
 }
 
@@ -528,9 +541,8 @@ mod tests {
 
     #[test]
     fn turn_golden_and_the_two_modes_do_not_mix() {
-        let t = Turn::by_deci_degrees(900);
-        assert_eq!(t.encode(), TURN_90);
-        assert_eq!(Turn::decode(&TURN_90), Ok(t));
+        assert_eq!(Turn::by_deci_degrees(900).encode(), TURN_90);
+        assert_eq!(Turn::decode(&TURN_90), Ok(Turn::by_deci_degrees(900)));
         assert_eq!(Velocity::decode(&TURN_90), Err(Error::Mode));
         assert_eq!(Turn::decode(&VELOCITY_MIXED), Err(Error::Mode));
     }

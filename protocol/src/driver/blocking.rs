@@ -1,10 +1,14 @@
 //! [`Driver`]: the blocking shell over `embedded-io` 0.7 `Read + Write + ReadReady`.
 //!
+//! It only moves bytes and time between the UART and the [`DriverCore`]: every decision (reply
+//! matching, retries, timeouts, the settings sequences, the failsafe, the turn guard) is the
+//! core's. A HAL that hands out RX and TX halves is driven through [`Split`](super::Split).
+//!
 //! ```
 //! # #[cfg(feature = "sim")] {
-//! use chassis_protocol::driver::{Config, blocking::Driver};
+//! use chassis_protocol::driver::{Config, blocking::Driver, reg};
 //! use chassis_protocol::sim::{Board, SimClock, SimConfig, SimUart};
-//! use chassis_protocol::{Register, Velocity};
+//! use chassis_protocol::Velocity;
 //! use core::cell::Cell;
 //!
 //! // The simulated board behind an in-memory UART, with a simulated clock (1 ms a reading).
@@ -12,17 +16,23 @@
 //! let uart = SimUart::new(Board::new(SimConfig::default()), &time);
 //! let mut driver = Driver::new(uart, SimClock(&time), Config::DEFAULT);
 //! driver.set_velocity(Velocity::new(0, 200, 0))?;
-//! let voltage = driver.read_register(Register::MotorVoltage)?;
-//! assert_eq!(voltage.value, 1_200);
+//! let centivolts: u16 = driver.read(reg::MotorVoltage)?; // typed: the register's own type
+//! assert_eq!(centivolts, 1_200);
 //! # }
 //! # Ok::<(), chassis_protocol::driver::Error<core::convert::Infallible>>(())
 //! ```
 
-use super::{Clock, Config, DriverCore, Error, Event, RxBuffer};
-use crate::command::{Action, Motors, Register, Setting, Velocity, Write};
+use super::{
+    Clock, Config, CoreError, DriverCore, Error, Event, Outcome, Readable, Request, RxBuffer,
+};
+use crate::command::{Action, Motors, Register, Turn, Velocity, Write};
 use crate::registers::Settings;
-use crate::telemetry::Reply;
 use embedded_io::{Read, ReadReady, Write as IoWrite};
+
+/// Polls in a row that see the clock stand still and no byte come before a wait gives up with
+/// [`Error::ClockStalled`] (a millisecond clock that never moves would otherwise hang a read).
+/// A million polls take far longer than a millisecond on any microcontroller.
+pub const STALL_POLLS: u32 = 1_000_000;
 
 /// The blocking driver: owns the UART and the clock (give them back with
 /// [`release`](Driver::release)); bytes read but not yet parsed are kept between calls.
@@ -34,10 +44,6 @@ pub struct Driver<U, C> {
     core: DriverCore,
     rx: RxBuffer,
 }
-
-// RAM of the driver itself, without the UART, clock (and delay) it owns: 400 bytes on ARM.
-#[cfg(target_arch = "arm")]
-const _: () = assert!(core::mem::size_of::<Driver<(), ()>>() == 400);
 
 impl<U, C> Driver<U, C>
 where
@@ -75,6 +81,11 @@ where
         &self.core
     }
 
+    /// The sans-IO core, mutably: [`DriverCore::abandon_turn`], [`DriverCore::abort`].
+    pub fn core_mut(&mut self) -> &mut DriverCore {
+        &mut self.core
+    }
+
     /// Sets the body velocity (see [`Velocity`] for the drive types). Safe to call every period.
     pub fn set_velocity(&mut self, velocity: Velocity) -> Result<(), Error<U::Error>> {
         let now = self.clock.now_ms();
@@ -89,143 +100,180 @@ where
         self.send(&bytes)
     }
 
-    /// Stops the chassis.
+    /// Stops the chassis; if a turn is outstanding, cancels it too (reads the angle still
+    /// pending and sends the opposite turn) and returns when that is done.
     pub fn stop(&mut self) -> Result<(), Error<U::Error>> {
         let bytes = self.core.stop();
-        self.send(&bytes)
-    }
-
-    /// Turns by `deci_degrees` (0.1°) **once**. While the turn is outstanding a new one is
-    /// [`Error::TurnInProgress`]; [`turn_remaining`](Driver::turn_remaining) reading 0 ends it.
-    pub fn turn_by(&mut self, deci_degrees: i32) -> Result<(), Error<U::Error>> {
-        let now = self.clock.now_ms();
-        let bytes = self.core.turn(deci_degrees, now)?;
-        self.send(&bytes)
-    }
-
-    /// Reads the angle still to turn (2D), in 0.1°. When it reads 0, the turn is over and a
-    /// new one may be sent.
-    pub fn turn_remaining(&mut self) -> Result<i32, Error<U::Error>> {
-        let reply = self.read_register(Register::PendingAngle)?;
-        Ok(reply.pending_deci_degrees().unwrap_or(0))
-    }
-
-    /// Reads one register: sends the read, then waits for its reply (telemetry that comes
-    /// meanwhile is taken in, never flushed).
-    pub fn read_register(&mut self, register: Register) -> Result<Reply, Error<U::Error>> {
-        let now = self.clock.now_ms();
-        let bytes = self.core.setting(Setting::Read(register), now)?;
         self.send(&bytes)?;
-        loop {
-            match self.poll()? {
-                Some(Event::Reply(reply)) => return Ok(reply),
-                Some(Event::StrayReply(reply)) => {
-                    // Give the read up: the caller hears of the wrong reply.
-                    self.core.cancel_read();
-                    return Err(Error::WrongReply {
-                        expected: register,
-                        got: reply.code,
-                    });
-                }
-                _ => {}
-            }
-            let now = self.clock.now_ms();
-            if let Some(register) = self.core.reply_timed_out(now) {
-                return Err(Error::Timeout(register));
-            }
+        if self.core.busy() {
+            self.finish().map(|_| ())
+        } else {
+            Ok(())
         }
     }
 
-    /// Reads a register until two replies agree (at most three reads). There is no checksum: a
-    /// byte changed on the line changes a reply's value unseen, so settings that matter are
-    /// worth reading this way. Two disagreeing replies and a third that matches neither is
-    /// [`Error::Unconfirmed`].
-    pub fn read_register_verified(&mut self, register: Register) -> Result<Reply, Error<U::Error>> {
-        let mut first = None;
-        let mut second = None;
-        for _ in 0..3 {
-            let reply = match self.read_register(register) {
-                Ok(reply) => reply,
-                // A reply lost or garbled on the line: try again.
-                Err(Error::Timeout(_) | Error::WrongReply { .. }) => continue,
-                Err(e) => return Err(e),
-            };
-            if first == Some(reply) || second == Some(reply) {
-                return Ok(reply);
-            }
-            second = first;
-            first = Some(reply);
-        }
-        Err(Error::Unconfirmed(register))
+    /// Sends a turn, **once**: the turn is consumed, and while one is outstanding a new one is
+    /// [`CoreError::TurnInProgress`]. [`turn_remaining`](Driver::turn_remaining) reading (nearly)
+    /// 0 ends it; [`stop`](Driver::stop) cancels it.
+    pub fn turn(&mut self, turn: Turn) -> Result<(), Error<U::Error>> {
+        let now = self.clock.now_ms();
+        let bytes = self.core.turn(turn, now)?;
+        self.send(&bytes)
+    }
+
+    /// [`turn`](Driver::turn) by `deci_degrees` (0.1°) standing still.
+    pub fn turn_by(&mut self, deci_degrees: i32) -> Result<(), Error<U::Error>> {
+        self.turn(Turn::by_deci_degrees(deci_degrees))
+    }
+
+    /// Reads the angle still to turn (2D), in 0.1°. When it reads (nearly) 0, the turn is over
+    /// and a new one may be sent.
+    pub fn turn_remaining(&mut self) -> Result<i32, Error<U::Error>> {
+        self.read(super::reg::PendingAngle)
+    }
+
+    /// Reads a register, typed (`driver.read(reg::MaxSpeed)` is a `u16`): one read, one reply.
+    /// A reply whose value cannot be the register's is [`CoreError::Invalid`].
+    pub fn read<R: Readable>(&mut self, register: R) -> Result<R::Value, Error<U::Error>> {
+        let _ = register;
+        let raw = self.read_raw(R::REGISTER)?;
+        R::from_raw(raw).ok_or(Error::Core(CoreError::Invalid {
+            register: R::REGISTER,
+            value: raw,
+        }))
+    }
+
+    /// Reads a register until two replies agree ([`Request::ReadVerified`]), typed.
+    pub fn read_verified<R: Readable>(&mut self, register: R) -> Result<R::Value, Error<U::Error>> {
+        let _ = register;
+        let raw = self.value(Request::ReadVerified(R::REGISTER))?;
+        R::from_raw(raw).ok_or(Error::Core(CoreError::Invalid {
+            register: R::REGISTER,
+            value: raw,
+        }))
+    }
+
+    /// Reads one register, untyped: its raw `u32`.
+    pub fn read_raw(&mut self, register: Register) -> Result<u32, Error<U::Error>> {
+        self.value(Request::Read(register))
     }
 
     /// Writes one register (2B). The board does not answer writes.
     pub fn write(&mut self, write: Write) -> Result<(), Error<U::Error>> {
-        self.setting(Setting::Write(write))
+        let now = self.clock.now_ms();
+        let bytes = self.core.write(write, now);
+        self.send(&bytes)
     }
 
     /// Runs one action (2A).
     pub fn action(&mut self, action: Action) -> Result<(), Error<U::Error>> {
-        self.setting(Setting::Action(action))
+        let now = self.clock.now_ms();
+        let bytes = self.core.action(action, now);
+        self.send(&bytes)
     }
 
-    /// Reads every register of a [`Settings`] snapshot.
+    /// Reads every register of a [`Settings`] snapshot, each read verified.
     pub fn read_settings(&mut self) -> Result<Settings, Error<U::Error>> {
-        let mut settings = Settings::default();
-        for register in Settings::REGISTERS {
-            let reply = self.read_register(register)?;
-            settings.apply(&reply);
+        match self.run(Request::ReadSettings)? {
+            Outcome::Settings(settings) => Ok(settings),
+            _ => Ok(Settings::default()),
         }
-        Ok(settings)
     }
 
-    /// Writes a snapshot back (all but the gyro calibration value, see [`Settings::writes`]).
+    /// Writes a snapshot back ([`Request::RestoreSettings`]: never starts a calibration).
     pub fn restore_settings(&mut self, settings: &Settings) -> Result<(), Error<U::Error>> {
-        for write in settings.writes() {
-            self.write(write)?;
-        }
-        Ok(())
+        self.run(Request::RestoreSettings(*settings)).map(|_| ())
     }
 
-    /// Takes in what has arrived, without blocking: returns the first event, if any. Also runs
-    /// the failsafe (sends stop if telemetry went silent while moving) and tells the parser
-    /// when the line has gone quiet. Call it often: every loop, or from the UART interrupt.
+    /// Runs any [`Request`] to its end.
+    pub fn run(&mut self, request: Request) -> Result<Outcome, Error<U::Error>> {
+        self.core.start(request)?;
+        self.finish()
+    }
+
+    /// Takes in what has arrived, without blocking: returns the first event, if any. Once every
+    /// byte the UART holds is in, it judges time (quiet line, reply timeouts, the failsafe) and
+    /// sends what the core has queued (a failsafe stop). Call it often: every loop, or from the
+    /// UART interrupt.
     pub fn poll(&mut self) -> Result<Option<Event>, Error<U::Error>> {
         let now = self.clock.now_ms();
-        if let Some(stop) = self.core.failsafe(now) {
-            self.send(&stop)?;
+        let result = self.pump(now);
+        if result.is_err() {
+            self.core.abort();
         }
+        result
+    }
+
+    fn value(&mut self, request: Request) -> Result<u32, Error<U::Error>> {
+        match self.run(request)? {
+            Outcome::Value(raw) => Ok(raw),
+            _ => Ok(0),
+        }
+    }
+
+    /// Pumps until the request in progress ends. Any error ends it (nothing stays busy).
+    fn finish(&mut self) -> Result<Outcome, Error<U::Error>> {
+        let mut stalled = 0u32;
+        let mut last = None;
+        loop {
+            let now = self.clock.now_ms();
+            if let Err(e) = self.pump(now) {
+                self.core.abort();
+                return Err(e);
+            }
+            if let Some(outcome) = self.core.take_outcome() {
+                return outcome.map_err(Error::Core);
+            }
+            if last == Some(now) && self.rx.is_empty() {
+                stalled = stalled.saturating_add(1);
+                if stalled >= STALL_POLLS {
+                    self.core.abort();
+                    return Err(Error::ClockStalled);
+                }
+            } else {
+                stalled = 0;
+                last = Some(now);
+            }
+        }
+    }
+
+    fn pump(&mut self, now: u64) -> Result<Option<Event>, Error<U::Error>> {
+        self.flush_out(now)?;
         loop {
             if let Some(event) = self.rx.drain(&mut self.core, now) {
                 return Ok(Some(event));
             }
-            if !self.uart.read_ready()? {
-                return Ok(self.core.quiet(now));
+            if !self.uart.read_ready().map_err(Error::Transport)? {
+                break;
             }
-            let n = self.uart.read(self.rx.space())?;
+            let n = self.uart.read(self.rx.space()).map_err(Error::Transport)?;
             self.rx.filled(n);
             if n == 0 {
-                return Ok(None);
+                break;
             }
         }
+        let event = self.core.tick(now);
+        self.flush_out(now)?;
+        Ok(event)
     }
 
-    fn setting(&mut self, setting: Setting) -> Result<(), Error<U::Error>> {
-        let now = self.clock.now_ms();
-        let bytes = self.core.setting(setting, now)?;
-        self.send(&bytes)
+    /// Sends every frame the core has queued.
+    fn flush_out(&mut self, now: u64) -> Result<(), Error<U::Error>> {
+        while let Some(frame) = self.core.transmit(now) {
+            self.send(frame.as_slice())?;
+        }
+        Ok(())
     }
 
     /// Writes all of `bytes` (a `write` of 0 is [`Error::WriteZero`], not a panic) and flushes.
     fn send(&mut self, mut bytes: &[u8]) -> Result<(), Error<U::Error>> {
         while !bytes.is_empty() {
-            let n = self.uart.write(bytes)?;
+            let n = self.uart.write(bytes).map_err(Error::Transport)?;
             if n == 0 {
                 return Err(Error::WriteZero);
             }
             bytes = bytes.get(n..).unwrap_or(&[]);
         }
-        self.uart.flush()?;
-        Ok(())
+        self.uart.flush().map_err(Error::Transport)
     }
 }

@@ -31,9 +31,11 @@ pub mod io06;
 #[cfg(feature = "nb")]
 pub mod nb;
 mod sans_io;
+mod split;
 
-pub use crate::registers::Settings;
-pub use sans_io::{DriverCore, Event, RxBuffer, Stamped, StreamInfo};
+pub use crate::registers::{BatteryRange, Readable, Settings, reg};
+pub use sans_io::{DriverCore, Event, Outcome, Outgoing, Request, RxBuffer, Stamped, StreamInfo};
+pub use split::Split;
 
 use crate::command::Register;
 use core::fmt;
@@ -51,32 +53,59 @@ impl<F: FnMut() -> u64> Clock for F {
     }
 }
 
-/// How the driver talks to the board.
+/// How the driver talks to the board, and its policies' limits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Config {
     /// Line speed in bits per second (the board's is 115 200).
     pub baud: u32,
     /// How long the board may take to answer a read, beyond the bytes' time on the wire, in ms.
     pub board_latency_ms: u32,
-    /// Telemetry silent for longer than this while the chassis is moving: the driver sends stop.
+    /// While moving, the board silent (no frame of any kind) for longer than this: the driver
+    /// sends stop.
     pub failsafe_ms: u32,
-    /// A line quiet for this long marks a frame boundary ([`crate::DownlinkParser::idle`]).
+    /// After a settings frame the board pauses its telemetry (A13: at least up to 500 ms); the
+    /// failsafe allows it this long to speak again.
+    pub settings_pause_ms: u32,
+    /// A line quiet for this long marks a frame boundary ([`crate::DownlinkParser::idle`]). It
+    /// must be longer than any gap *inside* a frame: 2 ms on a UART peripheral, more behind a
+    /// USB-UART adapter, which delivers bytes in bursts.
     pub idle_ms: u32,
+    /// A pending angle within this many 0.1° of 0 ends a turn (a board may leave a remainder).
+    pub turn_done_deci_degrees: u16,
+    /// Reads sent at most by a verified read ([`Request::ReadVerified`]).
+    pub read_tries: u8,
 }
 
 impl Config {
-    /// The board's line, 50 ms of board latency, a 100 ms failsafe (ten IMU periods), 2 ms idle.
+    /// A UART peripheral on a microcontroller: the board's line, 50 ms of board latency, a
+    /// 100 ms failsafe (ten IMU periods), 600 ms allowed for a settings pause, 2 ms idle.
     pub const DEFAULT: Config = Config {
         baud: 115_200,
         board_latency_ms: 50,
         failsafe_ms: 100,
+        settings_pause_ms: 600,
         idle_ms: 2,
+        turn_done_deci_degrees: 5,
+        read_tries: 4,
+    };
+
+    /// A PC or a Raspberry Pi behind a USB-UART adapter: the adapter hands bytes over in bursts
+    /// every 1 to 16 ms (its latency timer), both ways, and the OS adds its own scheduling. So a
+    /// quiet line is 40 ms (no burst gap inside a frame is mistaken for one), replies get 40 ms
+    /// more, and the failsafe is 200 ms.
+    pub const HOST: Config = Config {
+        board_latency_ms: 90,
+        failsafe_ms: 200,
+        idle_ms: 40,
+        ..Config::DEFAULT
     };
 
     /// How long to wait for a reply: the request (10 bytes), a telemetry frame that may be on
-    /// the wire first (15), and the reply (6), at 10 bits a byte, rounded up, plus the board's
-    /// latency. 53 ms with [`Config::DEFAULT`].
+    /// the wire first (15) and the reply (6), at 10 bits a byte, rounded up; the board's
+    /// latency; and [`idle_ms`](Config::idle_ms), since a reply alone on a quiet line is
+    /// proved by the quiet. 55 ms with [`Config::DEFAULT`].
     #[must_use]
     pub const fn reply_timeout_ms(&self) -> u32 {
         const BITS: u64 = (10 + 15 + 6) * 10;
@@ -88,6 +117,7 @@ impl Config {
             wire as u32
         };
         wire.saturating_add(self.board_latency_ms)
+            .saturating_add(self.idle_ms)
     }
 }
 
@@ -97,12 +127,11 @@ impl Default for Config {
     }
 }
 
-/// What can go wrong talking to the board; `E` is the transport's error.
+/// What the driver's logic can refuse or find wrong: no transport in it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Error<E> {
-    /// The UART failed.
-    Transport(E),
+#[non_exhaustive]
+pub enum CoreError {
     /// No reply to a read of this register within [`Config::reply_timeout_ms`].
     Timeout(Register),
     /// A reply came for another register than the one read (its code is here).
@@ -112,20 +141,76 @@ pub enum Error<E> {
         /// The code of the reply that came.
         got: u8,
     },
-    /// A read is already waiting for its reply.
+    /// A reply's value cannot be this register's (a 16-bit register with its high half set):
+    /// a damaged reply.
+    Invalid {
+        /// The register read.
+        register: Register,
+        /// The value that came.
+        value: u32,
+    },
+    /// Replies to reads of this register disagreed, or none came, in [`Config::read_tries`]
+    /// reads.
+    Unconfirmed(Register),
+    /// A request is already in progress.
     Busy,
     /// A turn is still outstanding: the board adds angles up, so a second one is refused until
-    /// the pending angle reads 0 (see the module docs).
+    /// the pending angle reads (nearly) 0, or the turn is cancelled.
     TurnInProgress,
-    /// The UART accepted no bytes (a write returned 0).
-    WriteZero,
-    /// Replies to reads of this register disagreed (bytes changed on the line).
-    Unconfirmed(Register),
+    /// The request was ended by [`DriverCore::stop`] (which cancels a turn first).
+    Aborted,
 }
 
-impl<E> From<E> for Error<E> {
-    fn from(e: E) -> Self {
-        Error::Transport(e)
+impl fmt::Display for CoreError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CoreError::Timeout(r) => write!(f, "no reply to a read of {r:?} in time"),
+            CoreError::WrongReply { expected, got } => {
+                write!(f, "reply code {got:#04x} while waiting for {expected:?}")
+            }
+            CoreError::Invalid { register, value } => {
+                write!(f, "reply value {value:#010x} cannot be {register:?}'s")
+            }
+            CoreError::Unconfirmed(r) => write!(f, "replies to reads of {r:?} did not agree"),
+            CoreError::Busy => f.write_str("a request is already in progress"),
+            CoreError::TurnInProgress => f.write_str("a turn is still outstanding"),
+            CoreError::Aborted => f.write_str("the request was ended by a stop"),
+        }
+    }
+}
+
+impl core::error::Error for CoreError {}
+
+/// What can go wrong talking to the board through a shell; `E` is the transport's error.
+/// Every one leaves the driver usable: no request stays in progress after it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum Error<E> {
+    /// The UART failed (an overrun, a framing error…: see the transport's error).
+    Transport(E),
+    /// The UART accepted no bytes (a write returned 0).
+    WriteZero,
+    /// The clock stood still while the driver waited: time never came to end the wait.
+    ClockStalled,
+    /// The driver's logic refused or found something wrong.
+    Core(CoreError),
+}
+
+impl<E> From<CoreError> for Error<E> {
+    fn from(e: CoreError) -> Self {
+        Error::Core(e)
+    }
+}
+
+impl<E> Error<E> {
+    /// The core's error, if this is one.
+    #[must_use]
+    pub const fn core(&self) -> Option<CoreError> {
+        match self {
+            Error::Core(e) => Some(*e),
+            _ => None,
+        }
     }
 }
 
@@ -133,14 +218,9 @@ impl<E: fmt::Debug> fmt::Display for Error<E> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Error::Transport(e) => write!(f, "UART error: {e:?}"),
-            Error::Timeout(r) => write!(f, "no reply to a read of {r:?} in time"),
-            Error::WrongReply { expected, got } => {
-                write!(f, "reply code {got:#04x} while waiting for {expected:?}")
-            }
-            Error::Busy => f.write_str("a read is already waiting for its reply"),
-            Error::TurnInProgress => f.write_str("a turn is still outstanding"),
             Error::WriteZero => f.write_str("the UART accepted no bytes"),
-            Error::Unconfirmed(r) => write!(f, "replies to reads of {r:?} disagreed"),
+            Error::ClockStalled => f.write_str("the clock stood still while waiting"),
+            Error::Core(e) => fmt::Display::fmt(e, f),
         }
     }
 }

@@ -1,17 +1,49 @@
-//! [`DriverCore`]: the driver's logic with no I/O and no clock.
+//! [`DriverCore`]: every policy of the driver, with no I/O and no clock.
+//!
+//! The shells ([`blocking`](super::blocking), [`asynch`](super::asynch)) only move bytes and
+//! time between a UART and this core; everything that decides lives here, once:
+//!
+//! * **Motion** frames come out at once ([`DriverCore::velocity`], [`DriverCore::motors`],
+//!   [`DriverCore::turn`], [`DriverCore::stop`]).
+//! * **Requests** that need replies ([`Request`]) run as a state machine: the core queues the
+//!   frames to send ([`DriverCore::transmit`]), matches replies as they come
+//!   ([`DriverCore::receive`]), times out and retries ([`DriverCore::tick`]), and leaves one
+//!   [`Outcome`] or [`CoreError`] to take ([`DriverCore::take_outcome`]). One request at a time;
+//!   [`DriverCore::abort`] ends one early (a transport error, a dropped future) and leaves the
+//!   core as if it had never started.
+//! * **The failsafe**, the quiet-line detection and the turn guard are judged in
+//!   [`DriverCore::tick`], which a shell calls once it has read everything the UART holds.
+//!
+//! # The failsafe in one sentence
+//!
+//! While the driver has the chassis moving, it sends STOP when it has heard **no frame** from
+//! the board (telemetry or reply) for [`Config::failsafe_ms`] (100 ms), except that after a
+//! settings frame the board may stay silent for [`Config::settings_pause_ms`] (600 ms), since it
+//! pauses telemetry while settings are made (A13: up to at least 500 ms).
+//!
+//! It is judged on the input already read: a shell calls [`DriverCore::tick`] only after taking
+//! in every byte the UART holds, so a slow loop never mistakes its own slowness for a dead link.
 
-use super::{Config, Error};
-use crate::command::{Motors, Register, Setting, Turn, Velocity};
+use super::{Config, CoreError};
+use crate::bytes::FrameBytes;
+use crate::command::{Action, Motors, Register, Setting, Turn, Velocity, Write};
 use crate::parse::{DownlinkParser, DownlinkStats, Lock};
+use crate::registers::{self, Settings};
 use crate::telemetry::{Battery, Encoders, Imu, Reply, Stream, Telemetry};
 
-/// A value and the time it arrived.
+/// The bytes of one command frame (10 or 12 bytes).
+pub type Outgoing = FrameBytes<12>;
+
+/// A value and the time the driver received it.
+///
+/// The time is when the bytes reached the core: the arrival time when a runner or an interrupt
+/// feeds the core as bytes come, the time of the read when a slow loop reads a batch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Stamped<T> {
     /// The value.
     pub value: T,
-    /// When it arrived, in ms.
+    /// When it was received, in ms.
     pub at_ms: u64,
 }
 
@@ -23,48 +55,95 @@ pub struct StreamInfo {
     pub frames: u32,
     /// Frames missing according to the count bytes.
     pub missed: u32,
-    /// Mean interval between frames, in µs (smoothed); 0 until two frames have come.
-    pub interval_us: u32,
-    last_ms: Option<u64>,
+    /// Frames per second over the last window of at least [`StreamInfo::WINDOW_MS`], in
+    /// thousandths (0 until a window has closed).
+    pub rate_millihertz: u32,
+    window_start_ms: Option<u64>,
+    window_frames: u32,
 }
 
 impl StreamInfo {
-    /// Frames per second, from the smoothed interval (0 until two frames have come).
+    /// The rate is counted over windows at least this long, so that frames read in batches (a
+    /// slow loop, a USB-UART) still give the stream's real rate.
+    pub const WINDOW_MS: u64 = 1_000;
+
+    /// Frames per second (rounded down; 0 until a window has closed).
     #[must_use]
-    pub fn rate_hz(&self) -> u32 {
-        1_000_000u32.checked_div(self.interval_us).unwrap_or(0)
+    pub const fn rate_hz(&self) -> u32 {
+        self.rate_millihertz / 1_000
     }
 
-    fn arrived(&mut self, at_ms: u64) {
+    fn arrived(&mut self, at_ms: u64, missed: u32) {
         self.frames = self.frames.wrapping_add(1);
-        if let Some(last) = self.last_ms {
-            let gap_us =
-                u32::try_from(at_ms.saturating_sub(last).saturating_mul(1_000)).unwrap_or(u32::MAX);
-            // Exponential smoothing, 1/8 of the new interval.
-            self.interval_us = if self.interval_us == 0 {
-                gap_us
-            } else {
-                let old = self.interval_us;
-                old.saturating_sub(old / 8).saturating_add(gap_us / 8)
-            };
+        self.missed = missed;
+        let Some(start) = self.window_start_ms else {
+            self.window_start_ms = Some(at_ms);
+            return;
+        };
+        self.window_frames = self.window_frames.saturating_add(1);
+        let span = at_ms.saturating_sub(start);
+        if span >= Self::WINDOW_MS {
+            let rate = u64::from(self.window_frames)
+                .saturating_mul(1_000_000)
+                .checked_div(span)
+                .unwrap_or(0);
+            self.rate_millihertz = u32::try_from(rate).unwrap_or(u32::MAX);
+            self.window_start_ms = Some(at_ms);
+            self.window_frames = 0;
         }
-        self.last_ms = Some(at_ms);
     }
 }
 
-/// Something the core saw.
+/// Something the core saw on the line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Event {
     /// A telemetry frame (also kept as the latest of its stream).
     Telemetry(Telemetry),
-    /// The reply to the read that was waiting.
+    /// A reply that the request in progress was waiting for.
     Reply(Reply),
-    /// A reply for another register than the one waiting, or with none waiting.
+    /// A reply nobody waits for (a late one, or a damaged one).
     StrayReply(Reply),
 }
 
-/// Bytes read from the UART but not yet through the parser: what a shell keeps between calls so
+/// Something to do that needs the board's replies: started with [`DriverCore::start`], finished
+/// with an [`Outcome`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Request {
+    /// One read, one reply: [`Outcome::Value`]. A reply of another register is
+    /// [`CoreError::WrongReply`]; none in time, [`CoreError::Timeout`].
+    Read(Register),
+    /// Reads until two replies agree ([`Config::read_tries`] reads at most), retrying after a
+    /// timeout or a wrong reply; a reply whose value cannot be the register's is not counted.
+    /// There is no checksum: a changed byte changes a reply unseen, and this is how a value
+    /// that matters is read. [`Outcome::Value`], or [`CoreError::Unconfirmed`].
+    ReadVerified(Register),
+    /// Every register of a [`Settings`] snapshot, each read verified: [`Outcome::Settings`].
+    ReadSettings,
+    /// Writes a snapshot back (all but the calibration value: [`Settings::writes`]). The
+    /// system mode's gyro-compensation bit (3) is left as the board has it (read first):
+    /// switching it on starts a 30 s calibration, which a restore must never do by surprise.
+    /// [`Outcome::Done`].
+    RestoreSettings(Settings),
+    /// Cancels a turn in progress: reads the angle still pending and sends the opposite turn,
+    /// then releases the turn guard. [`Outcome::Done`].
+    CancelTurn,
+}
+
+/// How a [`Request`] ended well.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Outcome {
+    /// A register's raw value (see [`crate::registers::Readable`] for its type).
+    Value(u32),
+    /// A whole snapshot.
+    Settings(Settings),
+    /// Done: nothing to return.
+    Done,
+}
+
+/// Bytes read from the UART but not yet through the core: what a shell keeps between calls so
 /// that nothing is dropped when an event comes out mid-read.
 #[derive(Clone, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -94,9 +173,15 @@ impl RxBuffer {
         }
     }
 
+    /// Whether every byte read has gone through the core.
+    #[must_use]
+    pub const fn is_empty(&self) -> bool {
+        self.start >= self.end
+    }
+
     /// Feeds the bytes held to `core` until one completes an event.
     pub fn drain(&mut self, core: &mut DriverCore, now_ms: u64) -> Option<Event> {
-        if self.start >= self.end {
+        if self.is_empty() {
             return None;
         }
         let pending = self.bytes.get(self.start..self.end).unwrap_or(&[]);
@@ -118,64 +203,131 @@ impl RxBuffer {
     }
 }
 
-/// The turn guard: see the module docs of [`crate::driver`].
+/// The read in flight, if any.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-enum TurnState {
-    Idle,
-    Outstanding,
+struct Read {
+    register: Register,
+    verified: bool,
+    /// Sent, and waiting for its reply until this time; `None`: still to send.
+    deadline_ms: Option<u64>,
+    /// Reads sent so far.
+    tries: u8,
+    /// Values seen so far (verified reads), most recent first.
+    seen: [Option<u32>; 2],
 }
 
-/// The driver's logic: frames out, telemetry in, reply matching, the reply timeout, the
-/// failsafe and the one-shot turn guard. No I/O, no clock: bytes and the time in ms come in as
-/// arguments, bytes to send come out.
+impl Read {
+    const fn new(register: Register, verified: bool) -> Self {
+        Read {
+            register,
+            verified,
+            deadline_ms: None,
+            tries: 0,
+            seen: [None, None],
+        }
+    }
+}
+
+/// What a request is doing now.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+enum Step {
+    /// A read (sent or to send).
+    Read(Read),
+    /// A write to send (restore), then the next step.
+    Write(Write),
+    /// The opposite turn to send (cancel), in 0.1°.
+    CounterTurn(i32),
+}
+
+/// The request in progress.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Job {
+    request: Request,
+    step: Step,
+    /// Which step of the request's sequence this is.
+    index: u8,
+    /// Settings read so far (ReadSettings).
+    settings: Settings,
+}
+
+/// The driver's logic: frames out, telemetry in, requests and their replies, timeouts and
+/// retries, the failsafe and the one-shot turn guard. No I/O, no clock: bytes and the time in ms
+/// come in as arguments, bytes to send come out.
+///
+/// ```
+/// use chassis_protocol::driver::{Config, DriverCore, Outcome, Request};
+/// use chassis_protocol::{Register, Reply};
+///
+/// let mut core = DriverCore::new(Config::DEFAULT);
+/// core.start(Request::Read(Register::MotorVoltage))?;
+/// let frame = core.transmit(0).unwrap(); // the read, to write to the UART
+/// assert_eq!(frame.as_slice(), [0xFF, 0xFE, 0x80, 0x80, 0x1B, 0, 0, 0, 0, 0]);
+/// // The reply comes; the line goes quiet, which ends it.
+/// let _ = core.receive(&[0x23, 0x0B, 0x00, 0x00, 0x04, 0xB0], 3);
+/// while core.tick(10).is_some() {}
+/// assert_eq!(core.take_outcome(), Some(Ok(Outcome::Value(1_200))));
+/// # Ok::<(), chassis_protocol::driver::CoreError>(())
+/// ```
 #[derive(Clone, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct DriverCore {
     config: Config,
     parser: DownlinkParser,
-    waiting: Option<(Register, u64)>,
+    job: Option<Job>,
+    outcome: Option<Result<Outcome, CoreError>>,
+    stop_queued: bool,
     imu: Option<Stamped<Imu>>,
     encoders: Option<Stamped<Encoders>>,
     battery: Option<Stamped<Battery>>,
     streams: [StreamInfo; 3],
+    /// The last frame of any kind (telemetry or reply): the board is alive.
+    last_heard_ms: Option<u64>,
     last_telemetry_ms: Option<u64>,
     last_byte_ms: Option<u64>,
+    /// The last settings frame sent: the board may pause its telemetry after it.
+    settings_sent_ms: Option<u64>,
     moving_since_ms: Option<u64>,
-    turn: TurnState,
+    turning: bool,
     failsafe_stops: u32,
 }
 
-// RAM budget of the core (the parser, latest frames, stream figures, timers): 360 bytes on
-// thumbv7em and on 64-bit hosts alike (u64 is 8-aligned on both).
+// RAM budget of the core (the parser 84 bytes, the request in progress 104, latest frames,
+// stream figures, timers): 520 bytes on 64-bit hosts and on thumbv7em alike.
 const _: () = assert!(
-    core::mem::size_of::<DriverCore>() <= 384,
+    core::mem::size_of::<DriverCore>() <= 544,
     "DriverCore over its RAM budget"
 );
-#[cfg(target_arch = "arm")]
-const _: () = assert!(core::mem::size_of::<DriverCore>() == 360);
 
 impl DriverCore {
     /// A core that has heard nothing and sent nothing.
     #[must_use]
     pub const fn new(config: Config) -> Self {
+        const STREAM: StreamInfo = StreamInfo {
+            frames: 0,
+            missed: 0,
+            rate_millihertz: 0,
+            window_start_ms: None,
+            window_frames: 0,
+        };
         DriverCore {
             config,
             parser: DownlinkParser::new(),
-            waiting: None,
+            job: None,
+            outcome: None,
+            stop_queued: false,
             imu: None,
             encoders: None,
             battery: None,
-            streams: [StreamInfo {
-                frames: 0,
-                missed: 0,
-                interval_us: 0,
-                last_ms: None,
-            }; 3],
+            streams: [STREAM; 3],
+            last_heard_ms: None,
             last_telemetry_ms: None,
             last_byte_ms: None,
+            settings_sent_ms: None,
             moving_since_ms: None,
-            turn: TurnState::Idle,
+            turning: false,
             failsafe_stops: 0,
         }
     }
@@ -186,74 +338,161 @@ impl DriverCore {
         &self.config
     }
 
+    // ----- motion: frames out at once -----
+
     /// Bytes of a body-velocity frame (safe to send again and again).
     pub fn velocity(&mut self, velocity: Velocity, now_ms: u64) -> [u8; Velocity::LEN] {
         let moving = velocity.x != 0 || velocity.y != 0 || velocity.z != 0;
-        self.set_moving(moving, now_ms);
+        self.set_moving(moving || self.turning, now_ms);
         velocity.encode()
     }
 
     /// Bytes of a per-motor frame.
     pub fn motors(&mut self, motors: Motors, now_ms: u64) -> [u8; Motors::LEN] {
-        self.set_moving(motors.values.iter().any(|v| *v != 0), now_ms);
+        let moving = motors.values.iter().any(|v| *v != 0);
+        self.set_moving(moving || self.turning, now_ms);
         motors.encode()
     }
 
-    /// Bytes of the stop frame (all velocities 0).
+    /// Bytes of the stop frame (all velocities 0). If a turn is outstanding, it is cancelled
+    /// too: a [`Request::CancelTurn`] starts (ending any request in progress, which then gives
+    /// [`CoreError::Aborted`]), and its frames come out of [`transmit`](Self::transmit).
     pub fn stop(&mut self) -> [u8; Velocity::LEN] {
         self.moving_since_ms = None;
+        self.stop_queued = false;
+        if self.turning && !matches!(self.job, Some(j) if j.request == Request::CancelTurn) {
+            if self.job.is_some() {
+                self.finish(Err(CoreError::Aborted));
+            }
+            self.begin(Request::CancelTurn);
+        }
         Velocity::STOP.encode()
     }
 
-    /// Bytes of a turn by `deci_degrees` (0.1°), standing still, **once**: refused with
-    /// [`Error::TurnInProgress`] while an earlier turn is outstanding.
-    pub fn turn<E>(&mut self, deci_degrees: i32, now_ms: u64) -> Result<[u8; Turn::LEN], Error<E>> {
-        if self.turn == TurnState::Outstanding {
-            return Err(Error::TurnInProgress);
+    /// Bytes of a turn, **once**: refused with [`CoreError::TurnInProgress`] while an earlier
+    /// turn is outstanding. The turn is taken by value and consumed: a [`Turn`] cannot be sent
+    /// twice. The guard is released when a read of the pending angle comes back within
+    /// [`Config::turn_done_deci_degrees`] of 0 ([`Request::Read`] of
+    /// [`Register::PendingAngle`]), by [`Request::CancelTurn`], or by
+    /// [`abandon_turn`](Self::abandon_turn).
+    pub fn turn(&mut self, turn: Turn, now_ms: u64) -> Result<[u8; Turn::LEN], CoreError> {
+        if self.turning {
+            return Err(CoreError::TurnInProgress);
         }
-        self.turn = TurnState::Outstanding;
+        self.turning = true;
         self.set_moving(true, now_ms);
-        Ok(Turn::by_deci_degrees(deci_degrees).encode())
+        Ok(turn.encode())
     }
 
     /// Whether a turn is outstanding.
     #[must_use]
-    pub fn turning(&self) -> bool {
-        self.turn == TurnState::Outstanding
+    pub const fn turning(&self) -> bool {
+        self.turning
     }
 
     /// Forgets an outstanding turn without asking the board (after a board reset, say). The next
     /// [`turn`](DriverCore::turn) is then sent even if the board is still turning, and adds up.
     pub fn abandon_turn(&mut self) {
-        self.turn = TurnState::Idle;
+        self.turning = false;
     }
 
-    /// Bytes of a settings frame. A read arms the reply matching and its timeout; a second read
-    /// while one waits is [`Error::Busy`].
-    pub fn setting<E>(
-        &mut self,
-        setting: Setting,
-        now_ms: u64,
-    ) -> Result<[u8; Setting::LEN], Error<E>> {
-        if let Setting::Read(register) = setting {
-            if self.waiting.is_some() {
-                return Err(Error::Busy);
-            }
-            let deadline = now_ms.saturating_add(u64::from(self.config.reply_timeout_ms()));
-            self.waiting = Some((register, deadline));
+    // ----- settings without a reply: frames out at once -----
+
+    /// Bytes of a register write. The board pauses its telemetry while settings are made; the
+    /// failsafe allows for it (see the module docs).
+    pub fn write(&mut self, write: Write, now_ms: u64) -> [u8; Setting::LEN] {
+        self.settings_sent(now_ms);
+        Setting::Write(write).encode()
+    }
+
+    /// Bytes of an action (2A).
+    pub fn action(&mut self, action: Action, now_ms: u64) -> [u8; Setting::LEN] {
+        self.settings_sent(now_ms);
+        Setting::Action(action).encode()
+    }
+
+    // ----- requests -----
+
+    /// Starts a request; its frames come out of [`transmit`](Self::transmit), its end out of
+    /// [`take_outcome`](Self::take_outcome). [`CoreError::Busy`] while another runs.
+    pub fn start(&mut self, request: Request) -> Result<(), CoreError> {
+        if self.job.is_some() {
+            return Err(CoreError::Busy);
         }
-        Ok(setting.encode())
+        self.outcome = None;
+        self.begin(request);
+        Ok(())
     }
 
-    /// Gives up the read that waits for its reply (a late reply then comes as a stray one).
-    pub fn cancel_read(&mut self) {
-        self.waiting = None;
+    /// Ends the request in progress, if any, as if it had never started (no outcome). A reply
+    /// that comes later is a stray one. Shells call it when a transport error or a dropped
+    /// future cuts a request short, so no error leaves the driver busy.
+    pub fn abort(&mut self) {
+        self.job = None;
+        self.outcome = None;
+    }
+
+    /// Whether a request is in progress.
+    #[must_use]
+    pub const fn busy(&self) -> bool {
+        self.job.is_some()
     }
 
     /// The register whose reply is awaited, if any.
     #[must_use]
     pub fn waiting_for(&self) -> Option<Register> {
-        self.waiting.map(|(r, _)| r)
+        match self.job {
+            Some(Job {
+                step:
+                    Step::Read(Read {
+                        register,
+                        deadline_ms: Some(_),
+                        ..
+                    }),
+                ..
+            }) => Some(register),
+            _ => None,
+        }
+    }
+
+    /// How the last request ended, once it has (taken once).
+    pub fn take_outcome(&mut self) -> Option<Result<Outcome, CoreError>> {
+        self.outcome.take()
+    }
+
+    // ----- the pump: what the shells call -----
+
+    /// The next frame to send now, if any: a failsafe stop first, then the request's frames.
+    /// A read's reply timeout starts when its frame is taken from here.
+    pub fn transmit(&mut self, now_ms: u64) -> Option<Outgoing> {
+        if self.stop_queued {
+            self.stop_queued = false;
+            return Some(Outgoing::new(&Velocity::STOP.encode()));
+        }
+        let job = self.job.as_mut()?;
+        match &mut job.step {
+            Step::Read(read) if read.deadline_ms.is_none() => {
+                let timeout = u64::from(self.config.reply_timeout_ms());
+                read.deadline_ms = Some(now_ms.saturating_add(timeout));
+                read.tries = read.tries.saturating_add(1);
+                let frame = Setting::Read(read.register).encode();
+                self.settings_sent(now_ms);
+                Some(Outgoing::new(&frame))
+            }
+            Step::Read(_) => None,
+            Step::Write(write) => {
+                let frame = Setting::Write(*write).encode();
+                self.settings_sent(now_ms);
+                self.advance(None);
+                Some(Outgoing::new(&frame))
+            }
+            Step::CounterTurn(deci_degrees) => {
+                let frame = Turn::by_deci_degrees(*deci_degrees).encode();
+                self.turning = false;
+                self.advance(None);
+                Some(Outgoing::new(&frame))
+            }
+        }
     }
 
     /// Feeds received bytes; returns the first event they complete and the bytes not yet
@@ -262,61 +501,56 @@ impl DriverCore {
         if !bytes.is_empty() {
             self.last_byte_ms = Some(now_ms);
         }
-        let mut rest = bytes;
-        loop {
-            let (frame, later) = self.parser.push_slice(rest);
-            rest = later;
-            match frame {
-                Some(frame) => {
-                    if let Some(event) = self.frame(frame, now_ms) {
-                        return (Some(event), rest);
-                    }
-                }
-                None => return (None, rest),
-            }
-        }
+        let (frame, rest) = self.parser.push_slice(bytes);
+        (frame.map(|frame| self.frame(frame, now_ms)), rest)
     }
 
-    /// Call when no byte has arrived for a while: after [`Config::idle_ms`] of silence the line
-    /// is quiet, which completes a frame that waits for proof (a reply alone on the line).
-    pub fn quiet(&mut self, now_ms: u64) -> Option<Event> {
-        let silent = self
+    /// Judges time: a quiet line (a frame that waited for one comes out: call until `None`),
+    /// the reply timeout (retry or error), and the failsafe (a stop queued for
+    /// [`transmit`](Self::transmit)). Call it once every byte the UART holds has gone through
+    /// [`receive`](Self::receive).
+    pub fn tick(&mut self, now_ms: u64) -> Option<Event> {
+        let quiet = self
             .last_byte_ms
             .is_some_and(|t| now_ms.saturating_sub(t) >= u64::from(self.config.idle_ms));
-        if !silent {
-            return None;
-        }
-        while let Some(frame) = self.parser.idle() {
-            if let Some(event) = self.frame(frame, now_ms) {
-                return Some(event);
+        if quiet {
+            if let Some(frame) = self.parser.idle() {
+                return Some(self.frame(frame, now_ms));
             }
+        }
+        self.check_reply_timeout(now_ms);
+        if self.failsafe_due(now_ms) {
+            self.moving_since_ms = None;
+            self.stop_queued = true;
+            self.failsafe_stops = self.failsafe_stops.wrapping_add(1);
         }
         None
     }
 
-    /// Checks the reply timeout: the register whose read has timed out (and is given up).
-    pub fn reply_timed_out(&mut self, now_ms: u64) -> Option<Register> {
-        match self.waiting {
-            Some((register, deadline)) if now_ms > deadline => {
-                self.waiting = None;
-                Some(register)
-            }
+    /// The next time [`tick`](Self::tick) may have something to do (a reply deadline, the
+    /// failsafe, a quiet line), for a shell that sleeps until then.
+    #[must_use]
+    pub fn next_deadline(&self) -> Option<u64> {
+        let reply = match self.job {
+            Some(Job {
+                step:
+                    Step::Read(Read {
+                        deadline_ms: Some(d),
+                        ..
+                    }),
+                ..
+            }) => Some(d.saturating_add(1)),
             _ => None,
-        }
+        };
+        let failsafe = self.failsafe_deadline().map(|d| d.saturating_add(1));
+        let quiet = match (self.last_byte_ms, self.parser.buffered()) {
+            (Some(t), 1..) => Some(t.saturating_add(u64::from(self.config.idle_ms))),
+            _ => None,
+        };
+        [reply, failsafe, quiet].into_iter().flatten().min()
     }
 
-    /// The failsafe: if the chassis is moving and telemetry has been silent for longer than
-    /// [`Config::failsafe_ms`], the stop frame to send now (once).
-    pub fn failsafe(&mut self, now_ms: u64) -> Option<[u8; Velocity::LEN]> {
-        let since = self.moving_since_ms?;
-        let heard = self.last_telemetry_ms.map_or(since, |t| t.max(since));
-        if now_ms.saturating_sub(heard) > u64::from(self.config.failsafe_ms) {
-            self.failsafe_stops = self.failsafe_stops.wrapping_add(1);
-            Some(self.stop())
-        } else {
-            None
-        }
-    }
+    // ----- state -----
 
     /// Times the failsafe has stopped the chassis.
     #[must_use]
@@ -324,14 +558,14 @@ impl DriverCore {
         self.failsafe_stops
     }
 
-    /// Whether telemetry has come within [`Config::failsafe_ms`].
+    /// Whether the board has been heard (a frame of any kind) within [`Config::failsafe_ms`].
     #[must_use]
     pub fn link_alive(&self, now_ms: u64) -> bool {
-        self.last_telemetry_ms
+        self.last_heard_ms
             .is_some_and(|t| now_ms.saturating_sub(t) <= u64::from(self.config.failsafe_ms))
     }
 
-    /// Whether the driver last told the chassis to move.
+    /// Whether the driver last told the chassis to move (a turn outstanding counts).
     #[must_use]
     pub const fn moving(&self) -> bool {
         self.moving_since_ms.is_some()
@@ -355,6 +589,12 @@ impl DriverCore {
         self.battery
     }
 
+    /// When the last telemetry frame came.
+    #[must_use]
+    pub const fn last_telemetry_ms(&self) -> Option<u64> {
+        self.last_telemetry_ms
+    }
+
     /// Rate and drops of one stream.
     #[must_use]
     pub fn stream(&self, stream: Stream) -> StreamInfo {
@@ -376,6 +616,8 @@ impl DriverCore {
         self.parser.lock()
     }
 
+    // ----- inside -----
+
     fn set_moving(&mut self, moving: bool, now_ms: u64) {
         self.moving_since_ms = match (moving, self.moving_since_ms) {
             (false, _) => None,
@@ -384,7 +626,194 @@ impl DriverCore {
         };
     }
 
-    fn frame(&mut self, frame: Telemetry, now_ms: u64) -> Option<Event> {
+    fn settings_sent(&mut self, now_ms: u64) {
+        self.settings_sent_ms = Some(now_ms);
+    }
+
+    /// When the failsafe falls due, if the chassis is moving.
+    fn failsafe_deadline(&self) -> Option<u64> {
+        let since = self.moving_since_ms?;
+        let heard = self.last_heard_ms.map_or(since, |t| t.max(since));
+        let silent_until = heard.saturating_add(u64::from(self.config.failsafe_ms));
+        let paused_until = self.settings_sent_ms.map_or(0, |t| {
+            t.saturating_add(u64::from(self.config.settings_pause_ms))
+        });
+        Some(silent_until.max(paused_until))
+    }
+
+    fn failsafe_due(&self, now_ms: u64) -> bool {
+        self.failsafe_deadline().is_some_and(|due| now_ms > due)
+    }
+
+    fn begin(&mut self, request: Request) {
+        let step = match request {
+            Request::Read(register) => Step::Read(Read::new(register, false)),
+            Request::ReadVerified(register) => Step::Read(Read::new(register, true)),
+            Request::ReadSettings => match Settings::REGISTERS.first() {
+                Some(register) => Step::Read(Read::new(*register, true)),
+                None => Step::Read(Read::new(Register::MaxSpeed, true)),
+            },
+            Request::RestoreSettings(_) => Step::Read(Read::new(Register::SystemMode, true)),
+            Request::CancelTurn => Step::Read(Read::new(Register::PendingAngle, true)),
+        };
+        self.job = Some(Job {
+            request,
+            step,
+            index: 0,
+            settings: Settings::default(),
+        });
+    }
+
+    fn finish(&mut self, outcome: Result<Outcome, CoreError>) {
+        self.job = None;
+        self.outcome = Some(outcome);
+    }
+
+    /// The current step is done (`value`: what a read gave): the request's next step, or its
+    /// outcome.
+    fn advance(&mut self, value: Option<u32>) {
+        let Some(mut job) = self.job else {
+            return;
+        };
+        if let (Some(raw), Step::Read(read)) = (value, job.step) {
+            if read.register == Register::PendingAngle
+                && (raw as i32).unsigned_abs() <= u32::from(self.config.turn_done_deci_degrees)
+            {
+                self.turning = false;
+            }
+        }
+        job.index = job.index.saturating_add(1);
+        let next = match (job.request, value) {
+            (Request::Read(_) | Request::ReadVerified(_), Some(raw)) => {
+                return self.finish(Ok(Outcome::Value(raw)));
+            }
+            (Request::ReadSettings, Some(raw)) => {
+                if let Step::Read(read) = job.step {
+                    if let Some(write) = Write::from_value(read.register, raw) {
+                        job.settings.set(write);
+                    }
+                }
+                match Settings::REGISTERS.get(usize::from(job.index)) {
+                    Some(register) => Step::Read(Read::new(*register, true)),
+                    None => return self.finish(Ok(Outcome::Settings(job.settings))),
+                }
+            }
+            (Request::RestoreSettings(mut settings), value) => {
+                if let Some(raw) = value {
+                    // The board's own compensation bit goes back unchanged.
+                    let live = crate::command::SystemMode::from_bits(raw).gyro_compensation();
+                    settings.system_mode = settings.system_mode.with_gyro_compensation(live);
+                    job.request = Request::RestoreSettings(settings);
+                }
+                let writes = settings.writes();
+                match writes.get(usize::from(job.index).saturating_sub(1)) {
+                    Some(write) => Step::Write(*write),
+                    None => return self.finish(Ok(Outcome::Done)),
+                }
+            }
+            (Request::CancelTurn, Some(raw)) => {
+                let pending = raw as i32;
+                if pending.unsigned_abs() <= u32::from(self.config.turn_done_deci_degrees) {
+                    self.turning = false;
+                    return self.finish(Ok(Outcome::Done));
+                }
+                Step::CounterTurn(pending.saturating_neg())
+            }
+            (Request::CancelTurn, None) => return self.finish(Ok(Outcome::Done)),
+            (Request::Read(_) | Request::ReadVerified(_) | Request::ReadSettings, None) => {
+                return self.finish(Ok(Outcome::Done));
+            }
+        };
+        job.step = next;
+        self.job = Some(job);
+    }
+
+    /// A reply came: does the read in flight take it?
+    fn reply(&mut self, reply: Reply) -> Event {
+        let Some(Job {
+            step: Step::Read(mut read),
+            ..
+        }) = self.job
+        else {
+            return Event::StrayReply(reply);
+        };
+        if read.deadline_ms.is_none() {
+            return Event::StrayReply(reply);
+        }
+        let matches = read.register.reply_code() == reply.code;
+        let fits = registers::fits(read.register, reply.value);
+        if !read.verified {
+            if !matches {
+                self.finish(Err(CoreError::WrongReply {
+                    expected: read.register,
+                    got: reply.code,
+                }));
+                return Event::StrayReply(reply);
+            }
+            if !fits {
+                self.finish(Err(CoreError::Invalid {
+                    register: read.register,
+                    value: reply.value,
+                }));
+                return Event::Reply(reply);
+            }
+            self.advance(Some(reply.value));
+            return Event::Reply(reply);
+        }
+        if matches && fits && read.seen.contains(&Some(reply.value)) {
+            self.advance(Some(reply.value));
+            return Event::Reply(reply);
+        }
+        if matches && fits {
+            let [latest, _] = read.seen;
+            read.seen = [Some(reply.value), latest];
+        }
+        self.retry(read);
+        if matches {
+            Event::Reply(reply)
+        } else {
+            Event::StrayReply(reply)
+        }
+    }
+
+    /// The read in flight gave nothing usable: send it again, or give up.
+    fn retry(&mut self, mut read: Read) {
+        if read.tries >= self.config.read_tries {
+            let error = if read.verified {
+                CoreError::Unconfirmed(read.register)
+            } else {
+                CoreError::Timeout(read.register)
+            };
+            return self.finish(Err(error));
+        }
+        read.deadline_ms = None;
+        if let Some(job) = self.job.as_mut() {
+            job.step = Step::Read(read);
+        }
+    }
+
+    fn check_reply_timeout(&mut self, now_ms: u64) {
+        let Some(Job {
+            step: Step::Read(read),
+            ..
+        }) = self.job
+        else {
+            return;
+        };
+        match read.deadline_ms {
+            Some(deadline) if now_ms > deadline => {
+                if read.verified {
+                    self.retry(read);
+                } else {
+                    self.finish(Err(CoreError::Timeout(read.register)));
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn frame(&mut self, frame: Telemetry, now_ms: u64) -> Event {
+        self.last_heard_ms = Some(now_ms);
         let stream = match frame {
             Telemetry::Imu(value) => {
                 self.imu = Some(Stamped {
@@ -407,97 +836,181 @@ impl DriverCore {
                 });
                 Stream::Battery
             }
-            Telemetry::Reply(reply) => return Some(self.reply(reply)),
+            Telemetry::Reply(reply) => return self.reply(reply),
         };
         self.last_telemetry_ms = Some(now_ms);
         let missed = self.parser.stats().missed_of(stream);
         if let Some(info) = self.streams.get_mut(stream.index()) {
-            info.arrived(now_ms);
-            info.missed = missed;
+            info.arrived(now_ms, missed);
         }
-        Some(Event::Telemetry(frame))
-    }
-
-    fn reply(&mut self, reply: Reply) -> Event {
-        match self.waiting {
-            Some((register, _)) if register.reply_code() == reply.code => {
-                self.waiting = None;
-                if register == Register::PendingAngle && reply.value == 0 {
-                    self.turn = TurnState::Idle;
-                }
-                Event::Reply(reply)
-            }
-            _ => Event::StrayReply(reply),
-        }
+        Event::Telemetry(frame)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Register;
-    use core::convert::Infallible;
 
-    type E = Error<Infallible>;
+    fn reply(core: &mut DriverCore, register: Register, value: u32, now: u64) {
+        let _ = core.receive(&Reply::new(register, value).encode(), now);
+        while core.tick(now.saturating_add(5)).is_some() {}
+    }
 
     #[test]
     fn reply_timeout_follows_the_baud_rate() {
-        assert_eq!(Config::DEFAULT.reply_timeout_ms(), 3 + 50);
+        assert_eq!(Config::DEFAULT.reply_timeout_ms(), 3 + 50 + 2);
         let slow = Config {
             baud: 9_600,
             board_latency_ms: 0,
+            idle_ms: 0,
             ..Config::DEFAULT
         };
         assert_eq!(slow.reply_timeout_ms(), 33);
     }
 
     #[test]
-    fn a_second_turn_is_refused_until_the_pending_angle_reads_zero() {
+    fn a_second_turn_is_refused_until_the_pending_angle_reads_near_zero() {
         let mut core = DriverCore::new(Config::DEFAULT);
-        assert!(core.turn::<Infallible>(900, 0).is_ok());
-        assert_eq!(core.turn::<Infallible>(900, 1), Err(E::TurnInProgress));
-        core.setting::<Infallible>(Setting::Read(Register::PendingAngle), 2)
-            .unwrap();
-        let (event, _) = core.receive(&Reply::new(Register::PendingAngle, 450).encode(), 3);
-        assert!(
-            event.is_none(),
-            "a lone reply waits for the next header or a quiet line"
-        );
-        assert!(matches!(core.quiet(10), Some(Event::Reply(_))));
-        assert!(core.turning(), "still 45.0° to go");
-        core.setting::<Infallible>(Setting::Read(Register::PendingAngle), 20)
-            .unwrap();
-        // After a quiet line the parser takes the next byte as a frame start: out at once.
-        let (event, _) = core.receive(&Reply::new(Register::PendingAngle, 0).encode(), 21);
-        assert!(matches!(event, Some(Event::Reply(_))));
-        assert!(!core.turning());
-        assert!(core.turn::<Infallible>(-900, 31).is_ok());
-    }
-
-    #[test]
-    fn failsafe_stops_once_when_telemetry_goes_silent_while_moving() {
-        let mut core = DriverCore::new(Config::DEFAULT);
-        core.velocity(Velocity::new(0, 100, 0), 0);
-        assert_eq!(core.failsafe(100), None);
-        assert_eq!(core.failsafe(101), Some(Velocity::STOP.encode()));
-        assert_eq!(core.failsafe(500), None);
-        assert_eq!(core.failsafe_stops(), 1);
-        // Standing still, silence is no reason to stop.
-        core.velocity(Velocity::STOP, 600);
-        assert_eq!(core.failsafe(10_000), None);
-    }
-
-    #[test]
-    fn reads_time_out_and_a_second_read_is_busy() {
-        let mut core = DriverCore::new(Config::DEFAULT);
-        core.setting::<Infallible>(Setting::Read(Register::SpeedKp), 0)
-            .unwrap();
+        assert!(core.turn(Turn::by_deci_degrees(900), 0).is_ok());
         assert_eq!(
-            core.setting::<Infallible>(Setting::Read(Register::SpeedKi), 1),
-            Err(E::Busy)
+            core.turn(Turn::by_deci_degrees(900), 1),
+            Err(CoreError::TurnInProgress)
         );
-        assert_eq!(core.reply_timed_out(53), None);
-        assert_eq!(core.reply_timed_out(54), Some(Register::SpeedKp));
+        core.start(Request::Read(Register::PendingAngle)).unwrap();
+        assert!(core.transmit(2).is_some());
+        reply(&mut core, Register::PendingAngle, 450, 3);
+        assert_eq!(core.take_outcome(), Some(Ok(Outcome::Value(450))));
+        assert!(core.turning(), "still 45.0° to go");
+        core.start(Request::Read(Register::PendingAngle)).unwrap();
+        assert!(core.transmit(20).is_some());
+        // A board that leaves a fraction of a degree still ends the turn.
+        reply(&mut core, Register::PendingAngle, (-3i32) as u32, 21);
+        assert!(!core.turning());
+        assert!(core.turn(Turn::by_deci_degrees(-900), 31).is_ok());
+    }
+
+    #[test]
+    fn reads_time_out_and_a_second_request_is_busy() {
+        let mut core = DriverCore::new(Config::DEFAULT);
+        core.start(Request::Read(Register::SpeedKp)).unwrap();
+        assert_eq!(
+            core.start(Request::Read(Register::SpeedKi)),
+            Err(CoreError::Busy)
+        );
+        assert!(core.transmit(0).is_some());
+        assert_eq!(core.waiting_for(), Some(Register::SpeedKp));
+        let _ = core.tick(55);
+        assert_eq!(core.take_outcome(), None);
+        let _ = core.tick(56);
+        assert_eq!(
+            core.take_outcome(),
+            Some(Err(CoreError::Timeout(Register::SpeedKp)))
+        );
         assert_eq!(core.waiting_for(), None);
+        assert!(core.start(Request::Read(Register::SpeedKi)).is_ok());
+    }
+
+    #[test]
+    fn abort_leaves_the_core_usable() {
+        let mut core = DriverCore::new(Config::DEFAULT);
+        core.start(Request::ReadSettings).unwrap();
+        assert!(core.transmit(0).is_some());
+        core.abort();
+        assert!(!core.busy());
+        assert_eq!(core.take_outcome(), None);
+        // The late reply is a stray one.
+        let _ = core.receive(&Reply::new(Register::MaxSpeed, 1).encode(), 1);
+        assert!(matches!(core.tick(10), Some(Event::StrayReply(_))));
+        assert!(core.start(Request::Read(Register::MaxSpeed)).is_ok());
+    }
+
+    #[test]
+    fn a_verified_read_needs_two_agreeing_replies_that_fit() {
+        let mut core = DriverCore::new(Config::DEFAULT);
+        core.start(Request::ReadVerified(Register::MaxSpeed))
+            .unwrap();
+        let mut now = 0;
+        // A damaged reply (high half set: no u16), then two good ones.
+        for value in [0x0001_03E8, 1_000, 1_000] {
+            assert!(core.transmit(now).is_some(), "a read goes out");
+            reply(&mut core, Register::MaxSpeed, value, now.saturating_add(1));
+            now = now.saturating_add(10);
+        }
+        assert_eq!(core.take_outcome(), Some(Ok(Outcome::Value(1_000))));
+    }
+
+    #[test]
+    fn a_verified_read_that_never_agrees_is_unconfirmed() {
+        let mut core = DriverCore::new(Config::DEFAULT);
+        core.start(Request::ReadVerified(Register::SpeedKp))
+            .unwrap();
+        let mut now = 0;
+        for value in [1, 2, 3, 4] {
+            assert!(core.transmit(now).is_some());
+            reply(&mut core, Register::SpeedKp, value, now.saturating_add(1));
+            now = now.saturating_add(10);
+        }
+        assert!(core.transmit(now).is_none(), "four tries at most");
+        assert_eq!(
+            core.take_outcome(),
+            Some(Err(CoreError::Unconfirmed(Register::SpeedKp)))
+        );
+    }
+
+    #[test]
+    fn the_failsafe_allows_the_settings_pause_but_not_a_dead_board() {
+        let mut core = DriverCore::new(Config::DEFAULT);
+        let _ = core.velocity(Velocity::new(0, 100, 0), 0);
+        let _ = core.tick(100);
+        assert_eq!(core.transmit(100), None);
+        let _ = core.tick(101);
+        assert_eq!(
+            core.transmit(101).map(|f| f.as_slice().to_vec()),
+            Some(Velocity::STOP.encode().to_vec())
+        );
+        assert_eq!(core.failsafe_stops(), 1);
+        // Moving again; a write makes the board pause: 600 ms allowed.
+        let _ = core.velocity(Velocity::new(0, 100, 0), 1_000);
+        let _ = core.write(Write::MaxSpeed(10), 1_000);
+        let _ = core.tick(1_599);
+        assert_eq!(core.transmit(1_599), None);
+        let _ = core.tick(1_601);
+        assert!(core.transmit(1_601).is_some());
+        // Standing still, silence is no reason to stop.
+        let _ = core.velocity(Velocity::STOP, 2_000);
+        let _ = core.tick(10_000);
+        assert_eq!(core.transmit(10_000), None);
+    }
+
+    #[test]
+    fn stop_cancels_an_outstanding_turn() {
+        let mut core = DriverCore::new(Config::DEFAULT);
+        let _ = core.turn(Turn::by_deci_degrees(900), 0).unwrap();
+        let _ = core.stop();
+        let read = core.transmit(100).unwrap();
+        assert_eq!(
+            read.as_slice(),
+            Setting::Read(Register::PendingAngle).encode()
+        );
+        reply(&mut core, Register::PendingAngle, 810, 101);
+        let again = core.transmit(106).unwrap();
+        assert_eq!(again.as_slice(), read.as_slice(), "verified: read twice");
+        reply(&mut core, Register::PendingAngle, 810, 107);
+        let counter = core.transmit(112).unwrap();
+        assert_eq!(counter.as_slice(), Turn::by_deci_degrees(-810).encode());
+        assert_eq!(core.take_outcome(), Some(Ok(Outcome::Done)));
+        assert!(!core.turning());
+    }
+
+    #[test]
+    fn rates_hold_for_frames_read_in_batches() {
+        let mut info = StreamInfo::default();
+        // A 1 Hz loop reading 100 frames a second, all stamped with the read's time.
+        for second in 1..=3u64 {
+            for _ in 0..100 {
+                info.arrived(second * 1_000, 0);
+            }
+        }
+        assert_eq!(info.rate_hz(), 100);
     }
 }

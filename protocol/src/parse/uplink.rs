@@ -242,7 +242,7 @@ mod tests {
         ];
         let mut p = UplinkParser::new();
         for command in commands {
-            let bytes = command.encode();
+            let bytes = command.clone().encode();
             let (last, body) = bytes.split_last().unwrap();
             for b in body {
                 assert_eq!(p.push(*b), None);
