@@ -51,8 +51,10 @@ use crate::registers::Settings;
 use crate::telemetry::{Battery, Encoders, Imu, Reply, Telemetry};
 use heapless::Deque;
 
-/// Bytes the board can hold for the master before it drops telemetry.
-pub const OUT_CAPACITY: usize = 512;
+/// Bytes the board's line can hold for the master before it drops telemetry: a second of
+/// telemetry (1 782 bytes) fits, as it does in a host's serial buffer, so a master that reads
+/// once a second loses nothing.
+pub const OUT_CAPACITY: usize = 2_048;
 
 /// How the simulated board behaves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -122,6 +124,9 @@ pub enum Motion {
     Motors([i32; 4]),
 }
 
+/// Time a byte takes on the wire at 115 200 bps, 8N1 (10 bits), in ns.
+const BYTE_NS: u64 = 86_806;
+
 /// Gyro calibration time: 10 s settle + 20 s still.
 const CALIBRATION_MS: u64 = 30_000;
 /// Turning speed in angle mode: 9 × 0.1° every 10 ms, 90°/s.
@@ -151,6 +156,14 @@ pub struct Board {
     calibrating_until_ms: Option<u64>,
     replies: Deque<(u64, Reply), 8>,
     out: Deque<u8, OUT_CAPACITY>,
+    /// The frames in `out` as (when their first byte starts on the wire in ns, length): bytes
+    /// leave at the line's pace (10 bits a byte at 115 200 bps), a frame from the moment it is
+    /// sent or the moment the one before it has left.
+    on_wire: Deque<(u64, u16), 160>,
+    /// Bytes of the front frame of `on_wire` already handed over.
+    front_taken: u16,
+    /// When the last byte queued will have left, in ns.
+    line_free_ns: u64,
     rng: u64,
     commands: u32,
     dropped_frames: u32,
@@ -194,6 +207,9 @@ impl Board {
             calibrating_until_ms: None,
             replies: Deque::new(),
             out: Deque::new(),
+            on_wire: Deque::new(),
+            front_taken: 0,
+            line_free_ns: 0,
             rng: config.seed | 1,
             commands: 0,
             dropped_frames: 0,
@@ -230,10 +246,25 @@ impl Board {
     /// Copies bytes for the master into `buf`, with the faults applied; returns how many.
     pub fn transmit(&mut self, buf: &mut [u8]) -> usize {
         let mut n = 0;
+        let now_ns = self.now_ms.saturating_mul(1_000_000);
         while n < buf.len() {
+            // Only the bytes that have crossed the wire by now.
+            let Some(&(start, len)) = self.on_wire.front() else {
+                break;
+            };
+            let taken = self.front_taken.saturating_add(1);
+            if start.saturating_add(u64::from(taken).saturating_mul(BYTE_NS)) > now_ns {
+                break;
+            }
             let Some(byte) = self.out.pop_front() else {
                 break;
             };
+            if taken >= len {
+                let _ = self.on_wire.pop_front();
+                self.front_taken = 0;
+            } else {
+                self.front_taken = taken;
+            }
             if self.chance(self.faults.drop_per_million) {
                 continue;
             }
@@ -553,10 +584,17 @@ impl Board {
     }
 
     fn send(&mut self, bytes: &[u8]) {
-        if self.out.capacity().saturating_sub(self.out.len()) < bytes.len() {
+        let room = self.out.capacity().saturating_sub(self.out.len());
+        let (Ok(len), false) = (u16::try_from(bytes.len()), room < bytes.len()) else {
+            self.dropped_frames = self.dropped_frames.wrapping_add(1);
+            return;
+        };
+        let start = self.line_free_ns.max(self.now_ms.saturating_mul(1_000_000));
+        if self.on_wire.push_back((start, len)).is_err() {
             self.dropped_frames = self.dropped_frames.wrapping_add(1);
             return;
         }
+        self.line_free_ns = start.saturating_add(u64::from(len).saturating_mul(BYTE_NS));
         for b in bytes {
             let _ = self.out.push_back(*b);
         }
@@ -683,7 +721,7 @@ impl embedded_io_async::Write for SimUart<'_> {
     }
 }
 
-/// A simulated delay for the async driver: waiting moves the shared time on.
+/// A simulated delay for the async driver: waiting moves the shared time on, and yields once.
 #[cfg(feature = "async")]
 #[derive(Clone, Copy, Debug)]
 pub struct SimDelay<'t>(pub &'t core::cell::Cell<u64>);
@@ -693,6 +731,8 @@ impl embedded_hal_async::delay::DelayNs for SimDelay<'_> {
     async fn delay_ns(&mut self, ns: u32) {
         let ms = u64::from(ns.div_ceil(1_000_000));
         self.0.set(self.0.get().saturating_add(ms));
+        // A real timer always hands the executor back: so does this one.
+        embassy_futures::yield_now().await;
     }
 }
 

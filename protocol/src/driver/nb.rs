@@ -35,6 +35,12 @@ impl<S> NbSerial<S> {
         NbSerial { serial, held: None }
     }
 
+    /// The serial port, mutably (a test double's controls; do not read from or write to it
+    /// behind the driver's back).
+    pub fn inner_mut(&mut self) -> &mut S {
+        &mut self.serial
+    }
+
     /// Gives back the serial port, and a byte read ahead by `read_ready` if there is one.
     pub fn release(self) -> (S, Option<u8>) {
         (self.serial, self.held)

@@ -203,12 +203,25 @@ impl RxBuffer {
     }
 }
 
+/// How a read's replies are judged.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+enum Check {
+    /// One reply, taken as it is (a wrong or unfitting one is an error).
+    Once,
+    /// Two replies that agree.
+    Agree,
+    /// One reply that can be the answer: the pending angle of a turn being cancelled, which
+    /// changes while it is read (so two reads cannot agree) but must lie between 0 and the turn.
+    Plausible,
+}
+
 /// The read in flight, if any.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 struct Read {
     register: Register,
-    verified: bool,
+    check: Check,
     /// Sent, and waiting for its reply until this time; `None`: still to send.
     deadline_ms: Option<u64>,
     /// Reads sent so far.
@@ -218,10 +231,10 @@ struct Read {
 }
 
 impl Read {
-    const fn new(register: Register, verified: bool) -> Self {
+    const fn new(register: Register, check: Check) -> Self {
         Read {
             register,
-            verified,
+            check,
             deadline_ms: None,
             tries: 0,
             seen: [None, None],
@@ -291,6 +304,8 @@ pub struct DriverCore {
     settings_sent_ms: Option<u64>,
     moving_since_ms: Option<u64>,
     turning: bool,
+    /// The angle of the outstanding turn, in 0.1°.
+    turn_deci_degrees: i32,
     failsafe_stops: u32,
 }
 
@@ -328,6 +343,7 @@ impl DriverCore {
             settings_sent_ms: None,
             moving_since_ms: None,
             turning: false,
+            turn_deci_degrees: 0,
             failsafe_stops: 0,
         }
     }
@@ -380,6 +396,7 @@ impl DriverCore {
             return Err(CoreError::TurnInProgress);
         }
         self.turning = true;
+        self.turn_deci_degrees = turn.deci_degrees;
         self.set_moving(true, now_ms);
         Ok(turn.encode())
     }
@@ -647,14 +664,16 @@ impl DriverCore {
 
     fn begin(&mut self, request: Request) {
         let step = match request {
-            Request::Read(register) => Step::Read(Read::new(register, false)),
-            Request::ReadVerified(register) => Step::Read(Read::new(register, true)),
+            Request::Read(register) => Step::Read(Read::new(register, Check::Once)),
+            Request::ReadVerified(register) => Step::Read(Read::new(register, Check::Agree)),
             Request::ReadSettings => match Settings::REGISTERS.first() {
-                Some(register) => Step::Read(Read::new(*register, true)),
-                None => Step::Read(Read::new(Register::MaxSpeed, true)),
+                Some(register) => Step::Read(Read::new(*register, Check::Agree)),
+                None => Step::Read(Read::new(Register::MaxSpeed, Check::Agree)),
             },
-            Request::RestoreSettings(_) => Step::Read(Read::new(Register::SystemMode, true)),
-            Request::CancelTurn => Step::Read(Read::new(Register::PendingAngle, true)),
+            Request::RestoreSettings(_) => {
+                Step::Read(Read::new(Register::SystemMode, Check::Agree))
+            }
+            Request::CancelTurn => Step::Read(Read::new(Register::PendingAngle, Check::Plausible)),
         };
         self.job = Some(Job {
             request,
@@ -694,7 +713,7 @@ impl DriverCore {
                     }
                 }
                 match Settings::REGISTERS.get(usize::from(job.index)) {
-                    Some(register) => Step::Read(Read::new(*register, true)),
+                    Some(register) => Step::Read(Read::new(*register, Check::Agree)),
                     None => return self.finish(Ok(Outcome::Settings(job.settings))),
                 }
             }
@@ -742,47 +761,55 @@ impl DriverCore {
         }
         let matches = read.register.reply_code() == reply.code;
         let fits = registers::fits(read.register, reply.value);
-        if !read.verified {
-            if !matches {
-                self.finish(Err(CoreError::WrongReply {
-                    expected: read.register,
-                    got: reply.code,
-                }));
-                return Event::StrayReply(reply);
-            }
-            if !fits {
-                self.finish(Err(CoreError::Invalid {
-                    register: read.register,
-                    value: reply.value,
-                }));
-                return Event::Reply(reply);
-            }
-            self.advance(Some(reply.value));
-            return Event::Reply(reply);
-        }
-        if matches && fits && read.seen.contains(&Some(reply.value)) {
-            self.advance(Some(reply.value));
-            return Event::Reply(reply);
-        }
-        if matches && fits {
-            let [latest, _] = read.seen;
-            read.seen = [Some(reply.value), latest];
-        }
-        self.retry(read);
-        if matches {
+        let event = if matches {
             Event::Reply(reply)
         } else {
             Event::StrayReply(reply)
+        };
+        match read.check {
+            Check::Once if !matches => self.finish(Err(CoreError::WrongReply {
+                expected: read.register,
+                got: reply.code,
+            })),
+            Check::Once if !fits => self.finish(Err(CoreError::Invalid {
+                register: read.register,
+                value: reply.value,
+            })),
+            Check::Once => self.advance(Some(reply.value)),
+            Check::Agree if matches && fits && read.seen.contains(&Some(reply.value)) => {
+                self.advance(Some(reply.value));
+            }
+            Check::Agree => {
+                if matches && fits {
+                    let [latest, _] = read.seen;
+                    read.seen = [Some(reply.value), latest];
+                }
+                self.retry(read);
+            }
+            Check::Plausible if matches && self.within_turn(reply.value) => {
+                self.advance(Some(reply.value));
+            }
+            Check::Plausible => self.retry(read),
         }
+        event
+    }
+
+    /// Whether a pending angle can be what is left of the outstanding turn: between 0 and the
+    /// turn's angle (give or take the tolerance).
+    fn within_turn(&self, raw: u32) -> bool {
+        let pending = i64::from(raw as i32);
+        let turn = i64::from(self.turn_deci_degrees);
+        let slack = i64::from(self.config.turn_done_deci_degrees);
+        let (low, high) = if turn >= 0 { (0, turn) } else { (turn, 0) };
+        (low.saturating_sub(slack)..=high.saturating_add(slack)).contains(&pending)
     }
 
     /// The read in flight gave nothing usable: send it again, or give up.
     fn retry(&mut self, mut read: Read) {
         if read.tries >= self.config.read_tries {
-            let error = if read.verified {
-                CoreError::Unconfirmed(read.register)
-            } else {
-                CoreError::Timeout(read.register)
+            let error = match read.check {
+                Check::Once => CoreError::Timeout(read.register),
+                Check::Agree | Check::Plausible => CoreError::Unconfirmed(read.register),
             };
             return self.finish(Err(error));
         }
@@ -801,13 +828,10 @@ impl DriverCore {
             return;
         };
         match read.deadline_ms {
-            Some(deadline) if now_ms > deadline => {
-                if read.verified {
-                    self.retry(read);
-                } else {
-                    self.finish(Err(CoreError::Timeout(read.register)));
-                }
-            }
+            Some(deadline) if now_ms > deadline => match read.check {
+                Check::Once => self.finish(Err(CoreError::Timeout(read.register))),
+                Check::Agree | Check::Plausible => self.retry(read),
+            },
             _ => {}
         }
     }
@@ -992,9 +1016,10 @@ mod tests {
             read.as_slice(),
             Setting::Read(Register::PendingAngle).encode()
         );
-        reply(&mut core, Register::PendingAngle, 810, 101);
+        // A damaged reply (more than the turn) is not believed: read again.
+        reply(&mut core, Register::PendingAngle, 8_100, 101);
         let again = core.transmit(106).unwrap();
-        assert_eq!(again.as_slice(), read.as_slice(), "verified: read twice");
+        assert_eq!(again.as_slice(), read.as_slice());
         reply(&mut core, Register::PendingAngle, 810, 107);
         let counter = core.transmit(112).unwrap();
         assert_eq!(counter.as_slice(), Turn::by_deci_degrees(-810).encode());
