@@ -26,6 +26,8 @@
 #[cfg(feature = "async")]
 pub mod asynch;
 pub mod blocking;
+#[cfg(feature = "std")]
+pub mod host;
 #[cfg(feature = "embedded-io-06")]
 pub mod io06;
 #[cfg(feature = "nb")]

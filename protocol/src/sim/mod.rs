@@ -51,6 +51,18 @@ use crate::registers::Settings;
 use crate::telemetry::{Battery, Encoders, Imu, Reply, Telemetry};
 use heapless::Deque;
 
+#[cfg(feature = "driver")]
+mod adapters;
+#[cfg(feature = "std")]
+mod serve;
+
+#[cfg(feature = "async")]
+pub use adapters::SimDelay;
+#[cfg(feature = "driver")]
+pub use adapters::{SimClock, SimUart};
+#[cfg(feature = "std")]
+pub use serve::serve;
+
 /// Bytes the board's line can hold for the master before it drops telemetry: a second of
 /// telemetry (1 782 bytes) fits, as it does in a host's serial buffer, so a master that reads
 /// once a second loses nothing.
@@ -288,6 +300,17 @@ impl Board {
             }
         }
         n
+    }
+
+    /// Whether a byte for the master has crossed the wire by now (what a UART's "data ready"
+    /// says).
+    #[must_use]
+    pub fn byte_arrived(&self) -> bool {
+        let now_ns = self.now_ms.saturating_mul(1_000_000);
+        self.on_wire.front().is_some_and(|&(start, _)| {
+            let next = u64::from(self.front_taken.saturating_add(1));
+            start.saturating_add(next.saturating_mul(BYTE_NS)) <= now_ns
+        })
     }
 
     /// The board's time in ms.
@@ -612,142 +635,6 @@ impl Board {
         x ^= x << 17;
         self.rng = x;
         x
-    }
-}
-
-/// The board behind an in-memory UART (features `sim` and `driver`): `embedded-io` `Read`,
-/// `Write` and `ReadReady`, for testing a master, or the [`crate::driver`], on the host. The
-/// board's time follows a shared [`Cell`](core::cell::Cell) of milliseconds, which
-/// [`SimClock`] advances.
-#[cfg(feature = "driver")]
-#[derive(Debug)]
-pub struct SimUart<'t> {
-    board: Board,
-    time: &'t core::cell::Cell<u64>,
-    burst_ms: u64,
-}
-
-#[cfg(feature = "driver")]
-impl<'t> SimUart<'t> {
-    /// `board` behind a UART, on the clock `time`.
-    pub fn new(board: Board, time: &'t core::cell::Cell<u64>) -> Self {
-        SimUart {
-            board,
-            time,
-            burst_ms: 1,
-        }
-    }
-
-    /// Hands the board's bytes over only every `burst_ms` ms, all at once, as a USB-UART
-    /// adapter does (its latency timer: 1 to 16 ms): a frame is often cut across two bursts.
-    #[must_use]
-    pub fn with_bursts(mut self, burst_ms: u64) -> Self {
-        self.burst_ms = burst_ms.max(1);
-        self
-    }
-
-    /// The board (to inspect it in a test).
-    pub fn board(&self) -> &Board {
-        &self.board
-    }
-
-    /// The board (to inject faults in a test).
-    pub fn board_mut(&mut self) -> &mut Board {
-        &mut self.board
-    }
-
-    fn catch_up(&mut self) {
-        let now = self.time.get();
-        let burst = now.checked_rem(self.burst_ms).unwrap_or(0);
-        self.board.advance(now.saturating_sub(burst));
-    }
-}
-
-#[cfg(feature = "driver")]
-impl embedded_io::ErrorType for SimUart<'_> {
-    type Error = core::convert::Infallible;
-}
-
-#[cfg(feature = "driver")]
-impl embedded_io::Read for SimUart<'_> {
-    fn read(&mut self, buf: &mut [u8]) -> Result<usize, Self::Error> {
-        self.catch_up();
-        Ok(self.board.transmit(buf))
-    }
-}
-
-#[cfg(feature = "driver")]
-impl embedded_io::ReadReady for SimUart<'_> {
-    fn read_ready(&mut self) -> Result<bool, Self::Error> {
-        self.catch_up();
-        Ok(!self.board.out.is_empty())
-    }
-}
-
-#[cfg(feature = "driver")]
-impl embedded_io::Write for SimUart<'_> {
-    fn write(&mut self, buf: &[u8]) -> Result<usize, Self::Error> {
-        self.catch_up();
-        self.board.receive(buf);
-        Ok(buf.len())
-    }
-
-    fn flush(&mut self) -> Result<(), Self::Error> {
-        Ok(())
-    }
-}
-
-/// Waits (yields to the executor) until a byte is there, as a real UART's read does.
-#[cfg(feature = "async")]
-impl embedded_io_async::Read for SimUart<'_> {
-    async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Self::Error> {
-        loop {
-            if embedded_io::ReadReady::read_ready(self)? || buf.is_empty() {
-                return embedded_io::Read::read(self, buf);
-            }
-            embassy_futures::yield_now().await;
-        }
-    }
-}
-
-#[cfg(feature = "async")]
-impl embedded_io_async::Write for SimUart<'_> {
-    async fn write(&mut self, buf: &[u8]) -> Result<usize, Self::Error> {
-        embedded_io::Write::write(self, buf)
-    }
-
-    async fn flush(&mut self) -> Result<(), Self::Error> {
-        Ok(())
-    }
-}
-
-/// A simulated delay for the async driver: waiting moves the shared time on, and yields once.
-#[cfg(feature = "async")]
-#[derive(Clone, Copy, Debug)]
-pub struct SimDelay<'t>(pub &'t core::cell::Cell<u64>);
-
-#[cfg(feature = "async")]
-impl embedded_hal_async::delay::DelayNs for SimDelay<'_> {
-    async fn delay_ns(&mut self, ns: u32) {
-        let ms = u64::from(ns.div_ceil(1_000_000));
-        self.0.set(self.0.get().saturating_add(ms));
-        // A real timer always hands the executor back: so does this one.
-        embassy_futures::yield_now().await;
-    }
-}
-
-/// A simulated clock: every reading moves the shared time on by 1 ms, so a driver that polls
-/// makes time pass. Share the cell with a [`SimUart`].
-#[cfg(feature = "driver")]
-#[derive(Clone, Copy, Debug)]
-pub struct SimClock<'t>(pub &'t core::cell::Cell<u64>);
-
-#[cfg(feature = "driver")]
-impl crate::driver::Clock for SimClock<'_> {
-    fn now_ms(&mut self) -> u64 {
-        let now = self.0.get().saturating_add(1);
-        self.0.set(now);
-        now
     }
 }
 

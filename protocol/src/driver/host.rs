@@ -1,0 +1,199 @@
+//! A PC or a Raspberry Pi (feature `std`): [`SerialPort`], a serial-port transport on the
+//! `serialport` crate (115 200 bps, 8N1), [`MonotonicClock`], and [`open`], which gives a
+//! blocking driver with [`Config::HOST`] (defaults that fit a USB-UART adapter's latency).
+//!
+//! ```no_run
+//! use chassis_protocol::driver::{host, reg};
+//! use chassis_protocol::Velocity;
+//!
+//! let mut driver = host::open("/dev/ttyUSB0")?;
+//! let volts = driver.read(reg::MotorVoltage)?;
+//! driver.set_velocity(Velocity::new(0, 200, 0))?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! `host-tests/examples/host_pty.rs` drives the simulated board through a pseudo-terminal with
+//! it: the real OS serial stack, no hardware.
+
+use super::blocking::Driver;
+use super::{Clock, Config};
+use std::io::{self, Read as _, Write as _};
+use std::time::{Duration, Instant};
+
+/// The board's line speed.
+pub const BAUD: u32 = 115_200;
+
+/// How long `read_ready` waits for a first byte before it says none is there: the driver's
+/// loop sleeps here instead of spinning.
+pub const WAIT_FOR_BYTE: Duration = Duration::from_millis(1);
+
+/// An OS serial port (a USB-UART adapter, a Raspberry Pi's UART, a pseudo-terminal) as the
+/// driver's transport: `embedded-io` `Read + Write + ReadReady`.
+pub struct SerialPort {
+    port: Box<dyn serialport::SerialPort>,
+    /// A byte read ahead by `read_ready`.
+    held: Option<u8>,
+}
+
+impl core::fmt::Debug for SerialPort {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("SerialPort")
+            .field("name", &self.port.name())
+            .field("held", &self.held)
+            .finish()
+    }
+}
+
+/// An error of the OS serial port.
+#[derive(Debug)]
+pub struct SerialError(pub io::Error);
+
+impl core::fmt::Display for SerialError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "serial port: {}", self.0)
+    }
+}
+
+impl std::error::Error for SerialError {}
+
+impl embedded_io::Error for SerialError {
+    fn kind(&self) -> embedded_io::ErrorKind {
+        match self.0.kind() {
+            io::ErrorKind::NotFound => embedded_io::ErrorKind::NotFound,
+            io::ErrorKind::PermissionDenied => embedded_io::ErrorKind::PermissionDenied,
+            io::ErrorKind::BrokenPipe => embedded_io::ErrorKind::BrokenPipe,
+            io::ErrorKind::InvalidInput => embedded_io::ErrorKind::InvalidInput,
+            io::ErrorKind::InvalidData => embedded_io::ErrorKind::InvalidData,
+            io::ErrorKind::TimedOut => embedded_io::ErrorKind::TimedOut,
+            io::ErrorKind::Interrupted => embedded_io::ErrorKind::Interrupted,
+            _ => embedded_io::ErrorKind::Other,
+        }
+    }
+}
+
+impl From<serialport::Error> for SerialError {
+    fn from(e: serialport::Error) -> Self {
+        SerialError(e.into())
+    }
+}
+
+impl SerialPort {
+    /// Opens `path` at 115 200 bps, 8 data bits, no parity, 1 stop bit, no flow control.
+    pub fn open(path: &str) -> Result<Self, SerialError> {
+        let port = serialport::new(path, BAUD)
+            .data_bits(serialport::DataBits::Eight)
+            .parity(serialport::Parity::None)
+            .stop_bits(serialport::StopBits::One)
+            .flow_control(serialport::FlowControl::None)
+            .timeout(WAIT_FOR_BYTE)
+            .open()?;
+        Ok(SerialPort { port, held: None })
+    }
+
+    /// A port opened some other way (a pseudo-terminal, a port with other settings).
+    pub fn from_port(mut port: Box<dyn serialport::SerialPort>) -> Result<Self, SerialError> {
+        port.set_timeout(WAIT_FOR_BYTE)?;
+        Ok(SerialPort { port, held: None })
+    }
+
+    /// The port's name, as the OS gives it.
+    #[must_use]
+    pub fn name(&self) -> Option<String> {
+        self.port.name()
+    }
+}
+
+impl embedded_io::ErrorType for SerialPort {
+    type Error = SerialError;
+}
+
+impl embedded_io::ReadReady for SerialPort {
+    /// Waits up to [`WAIT_FOR_BYTE`] for a byte.
+    fn read_ready(&mut self) -> Result<bool, SerialError> {
+        if self.held.is_some() || self.port.bytes_to_read()? > 0 {
+            return Ok(true);
+        }
+        let mut byte = [0u8];
+        match self.port.read(&mut byte) {
+            Ok(1) => {
+                let [b] = byte;
+                self.held = Some(b);
+                Ok(true)
+            }
+            Ok(_) => Ok(false),
+            Err(e) if e.kind() == io::ErrorKind::TimedOut => Ok(false),
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => Ok(false),
+            Err(e) => Err(SerialError(e)),
+        }
+    }
+}
+
+impl embedded_io::Read for SerialPort {
+    /// Hands out what is there without waiting (the driver calls it once `read_ready` said a
+    /// byte is).
+    fn read(&mut self, buf: &mut [u8]) -> Result<usize, SerialError> {
+        let Some((first, rest)) = buf.split_first_mut() else {
+            return Ok(0);
+        };
+        let mut n = 0;
+        let rest = match self.held.take() {
+            Some(byte) => {
+                *first = byte;
+                n = 1;
+                rest
+            }
+            None => buf,
+        };
+        let waiting = usize::try_from(self.port.bytes_to_read()?).unwrap_or(usize::MAX);
+        let take = waiting.min(rest.len());
+        if take > 0 {
+            if let Some(into) = rest.get_mut(..take) {
+                n = self.port.read(into).map_err(SerialError)?.saturating_add(n);
+            }
+        }
+        Ok(n)
+    }
+}
+
+impl embedded_io::Write for SerialPort {
+    fn write(&mut self, buf: &[u8]) -> Result<usize, SerialError> {
+        self.port.write(buf).map_err(SerialError)
+    }
+
+    fn flush(&mut self) -> Result<(), SerialError> {
+        self.port.flush().map_err(SerialError)
+    }
+}
+
+/// Milliseconds from a monotonic clock (`std::time::Instant`), from when it was made.
+#[derive(Clone, Copy, Debug)]
+pub struct MonotonicClock(Instant);
+
+impl MonotonicClock {
+    /// A clock starting at 0 now.
+    #[must_use]
+    pub fn new() -> Self {
+        MonotonicClock(Instant::now())
+    }
+}
+
+impl Default for MonotonicClock {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Clock for MonotonicClock {
+    fn now_ms(&mut self) -> u64 {
+        u64::try_from(self.0.elapsed().as_millis()).unwrap_or(u64::MAX)
+    }
+}
+
+/// The blocking driver over an OS serial port.
+pub type HostDriver = Driver<SerialPort, MonotonicClock>;
+
+/// Opens the serial port at `path` and gives a driver over it with [`Config::HOST`].
+pub fn open(path: &str) -> Result<HostDriver, SerialError> {
+    let port = SerialPort::open(path)?;
+    Ok(Driver::new(port, MonotonicClock::new(), Config::HOST))
+}
