@@ -55,7 +55,9 @@
 //!
 //! * `defmt`: `defmt::Format` for every public type.
 //! * `serde`: `Serialize` / `Deserialize` for the typed frames and counters.
-//! * `std`: links `std` (nothing needs it yet).
+//! * `std`: links `std`; `driver::host`, a serial-port transport (the `serialport` crate), a
+//!   monotonic clock and host defaults for a PC or a Raspberry Pi; `sim::serve` (the simulator
+//!   in real time on an OS byte stream).
 //! * `arbitrary`: `arbitrary::Arbitrary` for the frames, for fuzzing (values `decode` can return).
 //! * `driver`: the master-side driver, module `driver` (sans-IO core, blocking shell over
 //!   embedded-io 0.7); `nb`, `async`, `embedded-io-06`: its other shells and adapters.

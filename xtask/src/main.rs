@@ -194,7 +194,44 @@ fn test() -> Result<(), String> {
         let doc = ["doc", "-p", "chassis-protocol", "--no-deps", features];
         run_with(&cargo_program(), &doc, &[("RUSTDOCFLAGS", "-D warnings")])?;
     }
+    msrv()?;
     fuzz(FuzzRun::Repeatable)
+}
+
+/// The protocol crate, with every feature, builds with the `rust-version` the workspace
+/// declares (one place says it: the root `Cargo.toml`).
+fn msrv() -> Result<(), String> {
+    let manifest = workspace_root()?.join("Cargo.toml");
+    let text = std::fs::read_to_string(&manifest)
+        .map_err(|e| format!("cannot read {}: {e}", manifest.display()))?;
+    let version = text
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("rust-version = "))
+        .map(|v| v.trim_matches('"').to_string())
+        .ok_or("no rust-version in the workspace manifest")?;
+    if !rustup_list(&["toolchain", "list"])?
+        .iter()
+        .any(|l| l.starts_with(&format!("{version}-")) || l.starts_with(&format!("{version}.")))
+    {
+        run(
+            "rustup",
+            &["toolchain", "install", &version, "--profile", "minimal"],
+        )?;
+    }
+    // Its own target directory: another compiler's artefacts would only evict the main ones.
+    let toolchain = format!("+{version}");
+    run(
+        "cargo",
+        &[
+            &toolchain,
+            "check",
+            "-p",
+            "chassis-protocol",
+            "--all-features",
+            "--target-dir",
+            "target/msrv",
+        ],
+    )
 }
 
 /// The fuzz targets, in `host-tests/fuzz`, each with the number of runs `test` gives it (about

@@ -267,6 +267,16 @@ pub enum VelocityReading {
 /// let frame = Turn::by_deci_degrees(-900).encode();
 /// assert_eq!(frame, [0xFF, 0xFE, 0x01, 0x00, 0x00, 0x00, 0x00, 0x03, 0x84, 0b0001_0001]);
 /// ```
+///
+/// A turn is sent once: encoding consumes it, and it is not `Copy`.
+///
+/// ```compile_fail
+/// use chassis_protocol::Turn;
+///
+/// let turn = Turn::by_deci_degrees(900);
+/// let first = turn.encode();
+/// let again = turn.encode(); // error: `turn` was consumed by the first send
+/// ```
 // Not `Copy`: sending a turn consumes it ([`Turn::encode`] takes `self`), so one value cannot be
 // sent twice by accident; a second turn is a second value (or an explicit `clone`).
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]

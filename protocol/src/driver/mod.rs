@@ -2,26 +2,87 @@
 //!
 //! | layer | what | needs |
 //! |---|---|---|
-//! | [`DriverCore`] | all the logic: frames out, telemetry in, reply matching, timeouts, the failsafe, one-shot turns | nothing: bytes and the time come in as arguments |
+//! | [`DriverCore`] | every policy: frames out, telemetry in, requests (reads, verified reads, the settings sequences, turn cancel) with reply matching, retries and timeouts, the failsafe, the one-shot turn guard | nothing: bytes and the time come in as arguments |
 //! | [`blocking::Driver`] | owns the UART and a [`Clock`]; blocking calls | `embedded-io` 0.7 `Read + Write + ReadReady` |
-//! | `nb::NbSerial` (feature `nb`) | adapts an `embedded-hal-nb` 1.0 serial port for `blocking::Driver` | `serial::Read<u8> + serial::Write<u8>` |
-//! | `io06::Io06` (feature `embedded-io-06`) | adapts an `embedded-io` 0.6 UART for `blocking::Driver` | 0.6 `Read + Write + ReadReady` |
-//! | `asynch::Driver` (feature `async`) | the same calls, `async` | `embedded-io-async` 0.7 + `embedded-hal-async` `DelayNs` |
+//! | [`asynch::Driver`] (feature `async`) | the same calls, `async`; awaits bytes or the next deadline, never busy-polls | `embedded-io-async` 0.7 `Read + Write` (no `ReadReady`) + `embedded-hal-async` `DelayNs` |
+//! | [`Split`] | an RX half and a TX half as one UART, for either shell | the halves' traits |
+//! | `nb::NbSerial` (feature `nb`) | adapts an `embedded-hal-nb` 1.0 serial port for the blocking driver | `serial::Read<u8> + serial::Write<u8>` |
+//! | `io06::Io06` (feature `embedded-io-06`) | adapts an `embedded-io` 0.6 UART for the blocking driver | 0.6 `Read + Write + ReadReady` |
+//! | `host` (feature `std`) | a serial port (`serialport` crate), a monotonic clock, [`Config::HOST`] | a PC or a Raspberry Pi |
+//!
+//! # Which HAL, which shell
+//!
+//! Checked against each HAL's manifest and source for the version named:
+//!
+//! | HAL | UART type | implements | use |
+//! |---|---|---|---|
+//! | embassy-stm32 0.6 | `BufferedUart` (or its `split()` halves) | embedded-io 0.7 and embedded-io-async 0.7, with `ReadReady` | [`asynch::Driver`] (halves through [`Split`]), or [`blocking::Driver`] |
+//! | embassy-stm32 0.6 | `Uart<Async>` | embedded-io-async, no `ReadReady`; a DMA read is not cancel-safe | use `BufferedUart` instead |
+//! | embassy-rp 0.10 | `BufferedUart` | as embassy-stm32's | as embassy-stm32's |
+//! | embassy-nrf 0.11 | `BufferedUarte` (and its halves) | embedded-io-async 0.7 `Read + Write + ReadReady` only | [`asynch::Driver`] |
+//! | rp2040-hal 0.12 | `UartPeripheral` | embedded-io 0.7 and embedded-hal-nb 1.0 | [`blocking::Driver`] directly, or through `NbSerial` |
+//! | stm32f4xx-hal 0.23 | `Serial` | embedded-hal-nb 1.0; of embedded-io 0.6 only `Write` | `NbSerial` (not `Io06`: no 0.6 `Read`) |
+//! | esp-hal 1.x | `Uart` | embedded-io 0.7 behind its `unstable` feature; no embedded-hal-nb | [`blocking::Driver`] with esp-hal's `unstable` on |
+//!
+//! # The failsafe, in one sentence
+//!
+//! While the driver has the chassis moving, it sends STOP once no frame from the board
+//! (telemetry or reply) has been read for [`Config::failsafe_ms`] (100 ms), or, after a settings
+//! frame, for [`Config::settings_pause_ms`] (600 ms: the board pauses telemetry while settings
+//! are made, A13). It is judged only after every byte the UART holds has been read, so a loop
+//! slower than the limit is never stopped by its own slowness; such a loop stops a silent board
+//! at its first poll that reads nothing.
 //!
 //! # The angle hazard, and how the driver takes it away
 //!
 //! The board **adds up** every angle it receives (a frame with the angle-mode bit): a control
-//! loop that re-sends its last frame would spin the chassis without end. The driver never stores
-//! or re-sends an angle frame, and [`DriverCore::turn`] refuses a new turn while one is still
-//! outstanding: it is released only when a read of the pending angle (2D) comes back 0
-//! ([`blocking::Driver::turn_remaining`]), or by an explicit [`DriverCore::abandon_turn`]. A loop
-//! that calls `turn_by(900)` every period therefore turns the chassis 90° once, and gets
-//! [`Error::TurnInProgress`] until the turn is done.
+//! loop that re-sends its last frame would spin the chassis without end. In the types: a
+//! [`Turn`](crate::Turn) is not `Copy` and sending it consumes it; a
+//! [`Velocity`](crate::Velocity) can never carry the angle-mode bit, however it was made (serde
+//! included). In the driver: [`DriverCore::turn`] refuses a new turn while one is outstanding;
+//! the guard is released when a read of the pending angle comes back within
+//! [`Config::turn_done_deci_degrees`] of 0 (`turn_remaining()`), when `stop()` cancels the turn
+//! (it reads the pending angle and sends the opposite turn), or by an explicit
+//! [`DriverCore::abandon_turn`]. A loop that calls `turn_by(900)` every period turns the chassis
+//! 90° once and gets [`CoreError::TurnInProgress`] until the turn is done.
+//!
+//! # Errors
+//!
+//! [`CoreError`] is what the logic refuses or finds wrong; [`Error`] adds the transport's.
+//! **Every error leaves the driver usable**: a request cut short by a transport error, a stalled
+//! clock or a dropped future ends with it ([`DriverCore::abort`]).
+//!
+//! # Feeding the core from an interrupt or a DMA buffer
+//!
+//! The core needs no shell: an RX interrupt (or a DMA half-transfer callback) hands it bytes
+//! with the time, and the main loop takes frames to send. Bytes fed this way are stamped with
+//! their arrival time, which makes rates and the failsafe exact.
+//!
+//! ```ignore
+//! static CORE: Mutex<RefCell<DriverCore>> = Mutex::new(RefCell::new(DriverCore::new(Config::DEFAULT)));
+//!
+//! #[interrupt]
+//! fn USART2() {
+//!     let byte = uart_rx.read_byte();
+//!     critical_section::with(|cs| {
+//!         let mut core = CORE.borrow_ref_mut(cs);
+//!         let (event, _) = core.receive(&[byte], now_ms());    // one byte: never a rest
+//!         if let Some(Event::Telemetry(frame)) = event { LATEST.signal(frame) }
+//!     });
+//! }
+//!
+//! // Main loop, every few ms:
+//! critical_section::with(|cs| {
+//!     let mut core = CORE.borrow_ref_mut(cs);
+//!     while core.tick(now_ms()).is_some() {}                      // quiet line, timeouts, failsafe
+//!     while let Some(frame) = core.transmit(now_ms()) { uart_tx.write_all(&frame) }
+//! });
+//! ```
 //!
 //! # Time
 //!
-//! Time is milliseconds from any origin, as a `u64`; it must not go back. The blocking shell
-//! reads it from a [`Clock`].
+//! Time is milliseconds from any origin, as a `u64`; it must not go back. The shells read it
+//! from a [`Clock`].
 
 #[cfg(feature = "async")]
 pub mod asynch;
