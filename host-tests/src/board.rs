@@ -207,7 +207,7 @@ pub fn simulator_bursts(seed: u64, count: usize) -> (Vec<u8>, Vec<SentFrame>, Ve
     // About 126 frames a second; stop once enough bytes for `count` frames have come.
     while bytes.len() < count * 15 {
         ms += 1;
-        if ms % 500 == 0 {
+        if ms.is_multiple_of(500) {
             let register = Register::ALL[(ms / 500) as usize % Register::ALL.len()];
             board.receive(&Setting::Read(register).encode());
         }
