@@ -26,11 +26,21 @@
 //! assert_eq!(reply.map(|r| r.value), Some(1_200)); // 12.00 V, the factory default
 //! ```
 //!
+//! | file | what |
+//! |---|---|
+//! | `mod.rs` | [`Board`]: commands in, time on, the configuration ([`SimConfig`]) |
+//! | `registers.rs` | live and stored registers, [`FACTORY`] defaults, actions, calibration |
+//! | `motion.rs` | [`Motion`], wheel speeds per drive type, encoders, gyro, turns, battery drain |
+//! | `telemetry.rs` | the telemetry clock and frames |
+//! | `line.rs` | the line to the master: pacing at 115 200 bps, its buffer, [`Faults`] |
+//! | `adapters.rs` | (feature `driver`) in-memory UART, clock and delay on shared simulated time |
+//! | `serve.rs` | (feature `std`) the board in real time on an OS byte stream |
+//!
 //! # Behaviour, and the decisions where the spec is silent
 //!
-//! * **Registers** have a live copy and a stored copy. [`Action::Store`] copies live to stored,
+//! * **Registers** have a live copy and a stored copy. [`Action::Store`](crate::Action::Store) copies live to stored,
 //!   except system-mode bit 3 (gyro compensation), which the spec says is not stored;
-//!   [`Action::LoadStored`] and [`Action::LoadDefaults`] copy back.
+//!   [`Action::LoadStored`](crate::Action::LoadStored) and [`Action::LoadDefaults`](crate::Action::LoadDefaults) copy back.
 //! * **Gyro calibration** takes 30 s (10 s to settle, 20 s still) once compensation is switched
 //!   on, by action, system-mode write or a write of 0xFFFF to the calibration register. While it
 //!   runs, the calibration register reads 0xFFFF; then it reads the calibrated value.
@@ -38,35 +48,38 @@
 //!   its angle to the pending turn; the chassis turns at 90°/s until the pending angle is 0.
 //!   [`Board::total_turn_commanded`] tells a test what was asked in all.
 //! * **Telemetry pauses while settings are made** (A6): every settings frame stops it, and it
-//!   resumes [`SimConfig::resume_after_ms`] (100 ms) after the last one. Counts carry on from
+//!   resumes [`SimConfig::resume_after_ms`] (100 ms by default: a parameter, since the vendor
+//!   does not say, A13) after the last one. Counts carry on from
 //!   where they stopped (they count frames sent).
 //! * Replies go out [`SimConfig::reply_delay_ms`] after the read arrives.
 //! * Telemetry: IMU at 100 Hz, encoders at 25 Hz, battery at 1 Hz, each with its rolling count;
 //!   simple kinematics for omni, mecanum and differential chassis move the encoders and gyro Z;
 //!   the battery drains.
 
-use crate::command::{Action, Command, DriveType, Register, Setting, SystemMode, Write};
+use crate::command::Command;
 use crate::parse::UplinkParser;
 use crate::registers::Settings;
-use crate::telemetry::{Battery, Encoders, Imu, Reply, Telemetry};
+use crate::telemetry::Reply;
 use heapless::Deque;
 
 #[cfg(feature = "driver")]
 mod adapters;
+mod line;
+mod motion;
+mod registers;
 #[cfg(feature = "std")]
 mod serve;
+mod telemetry;
 
 #[cfg(feature = "async")]
 pub use adapters::SimDelay;
 #[cfg(feature = "driver")]
 pub use adapters::{SimClock, SimUart};
+pub use line::{Faults, OUT_CAPACITY};
+pub use motion::Motion;
+pub use registers::FACTORY;
 #[cfg(feature = "std")]
 pub use serve::serve;
-
-/// Bytes the board's line can hold for the master before it drops telemetry: a second of
-/// telemetry (1 782 bytes) fits, as it does in a host's serial buffer, so a master that reads
-/// once a second loses nothing.
-pub const OUT_CAPACITY: usize = 2_048;
 
 /// How the simulated board behaves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -89,62 +102,6 @@ impl Default for SimConfig {
         }
     }
 }
-
-/// Faults to inject into what the board sends; rates are per million bytes.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Faults {
-    /// A byte is lost.
-    pub drop_per_million: u32,
-    /// A byte arrives changed.
-    pub corrupt_per_million: u32,
-    /// A spurious byte arrives.
-    pub insert_per_million: u32,
-    /// The board sends no telemetry at all (a dead link, or a hung board).
-    pub telemetry_stopped: bool,
-    /// The board sends no replies.
-    pub replies_stopped: bool,
-}
-
-/// The factory defaults of the model (the vendor does not publish them; these are chosen).
-pub const FACTORY: Settings = Settings {
-    max_speed: 1_000,
-    speed_kp: 300,
-    speed_ki: 20,
-    gyro_gain: 50_000,
-    system_mode: SystemMode::new(DriveType::Mecanum),
-    gyro_calibration: 0x0200,
-    motor_centivolts: 1_200,
-    battery_full_centivolts: 0x7FFF,
-    battery_cutoff_centivolts: 0x7FFF,
-};
-
-/// What the chassis was last told to do.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Motion {
-    /// Body velocity (mode `01`, angle mode off).
-    Velocity {
-        /// X.
-        x: i32,
-        /// Y.
-        y: i32,
-        /// Z.
-        z: i32,
-    },
-    /// Each motor (modes `02` / `03`).
-    Motors([i32; 4]),
-}
-
-/// Time a byte takes on the wire at 115 200 bps, 8N1 (10 bits), in ns.
-const BYTE_NS: u64 = 86_806;
-
-/// Gyro calibration time: 10 s settle + 20 s still.
-const CALIBRATION_MS: u64 = 30_000;
-/// Turning speed in angle mode: 9 × 0.1° every 10 ms, 90°/s.
-const TURN_DECI_DEGREES_PER_10_MS: i64 = 9;
-/// Telemetry periods in ms: IMU, encoders, battery.
-const PERIODS_MS: [u64; 3] = [10, 40, 1_000];
 
 /// The simulated board.
 #[derive(Clone, Debug)]
@@ -255,64 +212,6 @@ impl Board {
         }
     }
 
-    /// Copies bytes for the master into `buf`, with the faults applied; returns how many.
-    pub fn transmit(&mut self, buf: &mut [u8]) -> usize {
-        let mut n = 0;
-        let now_ns = self.now_ms.saturating_mul(1_000_000);
-        while n < buf.len() {
-            // Only the bytes that have crossed the wire by now.
-            let Some(&(start, len)) = self.on_wire.front() else {
-                break;
-            };
-            let taken = self.front_taken.saturating_add(1);
-            if start.saturating_add(u64::from(taken).saturating_mul(BYTE_NS)) > now_ns {
-                break;
-            }
-            let Some(byte) = self.out.pop_front() else {
-                break;
-            };
-            if taken >= len {
-                let _ = self.on_wire.pop_front();
-                self.front_taken = 0;
-            } else {
-                self.front_taken = taken;
-            }
-            if self.chance(self.faults.drop_per_million) {
-                continue;
-            }
-            let byte = if self.chance(self.faults.corrupt_per_million) {
-                byte ^ (self.next_random() as u8 | 1)
-            } else {
-                byte
-            };
-            if self.chance(self.faults.insert_per_million) {
-                if let Some(slot) = buf.get_mut(n) {
-                    *slot = self.next_random() as u8;
-                    n = n.saturating_add(1);
-                }
-            }
-            if let Some(slot) = buf.get_mut(n) {
-                *slot = byte;
-                n = n.saturating_add(1);
-            } else {
-                // No room left for it after an insertion: keep it for the next call.
-                let _ = self.out.push_front(byte);
-            }
-        }
-        n
-    }
-
-    /// Whether a byte for the master has crossed the wire by now (what a UART's "data ready"
-    /// says).
-    #[must_use]
-    pub fn byte_arrived(&self) -> bool {
-        let now_ns = self.now_ms.saturating_mul(1_000_000);
-        self.on_wire.front().is_some_and(|&(start, _)| {
-            let next = u64::from(self.front_taken.saturating_add(1));
-            start.saturating_add(next.saturating_mul(BYTE_NS)) <= now_ns
-        })
-    }
-
     /// The board's time in ms.
     #[must_use]
     pub const fn now_ms(&self) -> u64 {
@@ -402,64 +301,6 @@ impl Board {
         }
     }
 
-    fn setting(&mut self, setting: Setting) {
-        self.quiet_until_ms = self
-            .now_ms
-            .saturating_add(u64::from(self.config.resume_after_ms));
-        match setting {
-            Setting::Action(action) => self.action(action),
-            Setting::Write(write) => {
-                let compensation_was = self.live.system_mode.gyro_compensation();
-                self.live.set(write);
-                match write {
-                    Write::GyroCalibration(0xFFFF) => self.start_calibration(),
-                    Write::SystemMode(mode) if mode.gyro_compensation() && !compensation_was => {
-                        self.start_calibration();
-                    }
-                    _ => {}
-                }
-            }
-            Setting::Read(register) => {
-                let value = match register {
-                    Register::PendingAngle => self.pending_deci_degrees() as u32,
-                    Register::GyroCalibration if self.calibrating() => 0xFFFF,
-                    other => self.live.value(other).unwrap_or(0),
-                };
-                let due = self
-                    .now_ms
-                    .saturating_add(u64::from(self.config.reply_delay_ms));
-                let _ = self.replies.push_back((due, Reply::new(register, value)));
-            }
-            Setting::Raw { .. } => {}
-        }
-    }
-
-    fn action(&mut self, action: Action) {
-        match action {
-            Action::LoadStored => self.live = self.stored,
-            Action::LoadDefaults => self.live = FACTORY,
-            Action::Store => {
-                // System-mode bit 3 is not stored.
-                let compensation = self.stored.system_mode.gyro_compensation();
-                self.stored = self.live;
-                self.stored.system_mode =
-                    self.stored.system_mode.with_gyro_compensation(compensation);
-            }
-            Action::GyroCompensationOff => {
-                self.live.system_mode = self.live.system_mode.with_gyro_compensation(false);
-            }
-            Action::GyroCompensationOn | Action::RecalibrateGyro => {
-                self.live.system_mode = self.live.system_mode.with_gyro_compensation(true);
-                self.start_calibration();
-            }
-            Action::Unknown(_) => {}
-        }
-    }
-
-    fn start_calibration(&mut self) {
-        self.calibrating_until_ms = Some(self.now_ms.saturating_add(CALIBRATION_MS));
-    }
-
     fn step_one_ms(&mut self) {
         let now = self.now_ms;
         if self.calibrating_until_ms.is_some_and(|end| now >= end) {
@@ -476,165 +317,7 @@ impl Board {
                 self.send(&reply.encode());
             }
         }
-        let sending = !self.faults.telemetry_stopped && !self.telemetry_paused();
-        for stream in 0..3 {
-            let (Some(due), Some(period)) = (
-                self.next_due_ms.get(stream).copied(),
-                PERIODS_MS.get(stream),
-            ) else {
-                continue;
-            };
-            if now < due {
-                continue;
-            }
-            if let Some(slot) = self.next_due_ms.get_mut(stream) {
-                *slot = due.saturating_add(*period);
-            }
-            if sending {
-                let frame = self.telemetry(stream);
-                self.send(&frame.encode());
-            }
-        }
-    }
-
-    /// Wheel speeds in encoder ticks per second for the current motion.
-    fn wheel_speeds(&self) -> [i32; 4] {
-        match self.motion {
-            Motion::Motors(values) => values,
-            Motion::Velocity { x, y, z } => match self.live.system_mode.drive_type() {
-                DriveType::Omni | DriveType::Mecanum => [
-                    y.saturating_add(x).saturating_add(z),
-                    y.saturating_sub(x).saturating_sub(z),
-                    y.saturating_add(x).saturating_sub(z),
-                    y.saturating_sub(x).saturating_add(z),
-                ],
-                DriveType::Differential => {
-                    let (left, right) = (y.saturating_sub(z), y.saturating_add(z));
-                    [left, right, right, left]
-                }
-                // No encoders to move.
-                DriveType::DifferentialOpenLoop | DriveType::Reserved(_) => [0; 4],
-            },
-        }
-    }
-
-    fn move_chassis(&mut self) {
-        let speeds = self.wheel_speeds();
-        for ((ticks, carry), speed) in self
-            .wheel_ticks
-            .iter_mut()
-            .zip(&mut self.tick_carry)
-            .zip(speeds)
-        {
-            // Ticks per second → per ms, carrying the remainder.
-            let total = carry.saturating_add(speed);
-            let whole = total / 1_000;
-            *carry = total % 1_000;
-            *ticks = ticks.wrapping_add(whole as i16);
-        }
-        if self.pending_deci_degrees != 0 {
-            // The rate (0.1° per 10 ms) goes to the gyro every ms; the angle moves on every 10.
-            let rate = self
-                .pending_deci_degrees
-                .clamp(-TURN_DECI_DEGREES_PER_10_MS, TURN_DECI_DEGREES_PER_10_MS);
-            if self.now_ms.checked_rem(10) == Some(0) {
-                self.pending_deci_degrees = self.pending_deci_degrees.saturating_sub(rate);
-            }
-            self.turn_carry = rate;
-        } else {
-            self.turn_carry = 0;
-        }
-        let moving = speeds.iter().any(|s| *s != 0) || self.turn_carry != 0;
-        let drain_every = if moving { 10_000 } else { 60_000 };
-        if self.now_ms.checked_rem(drain_every) == Some(0) {
-            self.centivolts = self.centivolts.saturating_sub(1);
-        }
-    }
-
-    fn telemetry(&mut self, stream: usize) -> Telemetry {
-        let seq = match self.seq.get_mut(stream) {
-            Some(s) => {
-                *s = s.wrapping_add(1);
-                *s
-            }
-            None => 0,
-        };
-        match stream {
-            0 => {
-                let noise = |b: &mut Board| ((b.next_random() % 9) as i16).wrapping_sub(4);
-                let rotation = match self.motion {
-                    Motion::Velocity { z, .. } => z,
-                    Motion::Motors(_) => 0,
-                };
-                let turning = clamp_i32(self.turn_carry.saturating_mul(10));
-                let gyro_z = rotation.saturating_add(turning).clamp(-32_768, 32_767) as i16;
-                Telemetry::Imu(Imu {
-                    accel: [
-                        noise(self),
-                        noise(self),
-                        16_384i16.wrapping_add(noise(self)),
-                    ],
-                    gyro: [noise(self), noise(self), gyro_z.saturating_add(noise(self))],
-                    seq,
-                })
-            }
-            1 => Telemetry::Encoders(Encoders {
-                ticks: self.wheel_ticks,
-                seq,
-            }),
-            _ => {
-                let (full, cutoff) = match (
-                    self.live.battery_full_centivolts,
-                    self.live.battery_cutoff_centivolts,
-                ) {
-                    (0x7FFF, _) | (_, 0x7FFF) => (1_260, 1_050),
-                    (full, cutoff) => (full, cutoff),
-                };
-                let span = u32::from(full.saturating_sub(cutoff)).max(1);
-                let above = u32::from(self.centivolts.saturating_sub(cutoff));
-                let percent = above
-                    .saturating_mul(100)
-                    .checked_div(span)
-                    .unwrap_or(0)
-                    .min(100) as u16;
-                Telemetry::Battery(Battery {
-                    centivolts: self.centivolts,
-                    percent,
-                    seq,
-                })
-            }
-        }
-    }
-
-    fn send(&mut self, bytes: &[u8]) {
-        let room = self.out.capacity().saturating_sub(self.out.len());
-        let (Ok(len), false) = (u16::try_from(bytes.len()), room < bytes.len()) else {
-            self.dropped_frames = self.dropped_frames.wrapping_add(1);
-            return;
-        };
-        let start = self.line_free_ns.max(self.now_ms.saturating_mul(1_000_000));
-        if self.on_wire.push_back((start, len)).is_err() {
-            self.dropped_frames = self.dropped_frames.wrapping_add(1);
-            return;
-        }
-        self.line_free_ns = start.saturating_add(u64::from(len).saturating_mul(BYTE_NS));
-        for b in bytes {
-            let _ = self.out.push_back(*b);
-        }
-    }
-
-    fn chance(&mut self, per_million: u32) -> bool {
-        per_million > 0 && (self.next_random() % 1_000_000) < u64::from(per_million)
-    }
-
-    /// xorshift64: enough for noise and faults, and the same on every target.
-    fn next_random(&mut self) -> u64 {
-        let mut x = self.rng;
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        self.rng = x;
-        x
+        self.send_due_telemetry(now);
     }
 }
 

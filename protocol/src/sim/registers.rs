@@ -1,0 +1,82 @@
+//! The board's registers: live and stored copies, factory defaults, actions, and the gyro
+//! calibration that switching compensation on starts.
+
+use super::Board;
+use crate::command::{Action, DriveType, Register, Setting, SystemMode, Write};
+use crate::registers::Settings;
+use crate::telemetry::Reply;
+
+/// The factory defaults of the model (the vendor does not publish them; these are chosen).
+pub const FACTORY: Settings = Settings {
+    max_speed: 1_000,
+    speed_kp: 300,
+    speed_ki: 20,
+    gyro_gain: 50_000,
+    system_mode: SystemMode::new(DriveType::Mecanum),
+    gyro_calibration: 0x0200,
+    motor_centivolts: 1_200,
+    battery_full_centivolts: 0x7FFF,
+    battery_cutoff_centivolts: 0x7FFF,
+};
+
+/// Gyro calibration time: 10 s settle + 20 s still.
+const CALIBRATION_MS: u64 = 30_000;
+impl Board {
+    pub(super) fn setting(&mut self, setting: Setting) {
+        self.quiet_until_ms = self
+            .now_ms
+            .saturating_add(u64::from(self.config.resume_after_ms));
+        match setting {
+            Setting::Action(action) => self.action(action),
+            Setting::Write(write) => {
+                let compensation_was = self.live.system_mode.gyro_compensation();
+                self.live.set(write);
+                match write {
+                    Write::GyroCalibration(0xFFFF) => self.start_calibration(),
+                    Write::SystemMode(mode) if mode.gyro_compensation() && !compensation_was => {
+                        self.start_calibration();
+                    }
+                    _ => {}
+                }
+            }
+            Setting::Read(register) => {
+                let value = match register {
+                    Register::PendingAngle => self.pending_deci_degrees() as u32,
+                    Register::GyroCalibration if self.calibrating() => 0xFFFF,
+                    other => self.live.value(other).unwrap_or(0),
+                };
+                let due = self
+                    .now_ms
+                    .saturating_add(u64::from(self.config.reply_delay_ms));
+                let _ = self.replies.push_back((due, Reply::new(register, value)));
+            }
+            Setting::Raw { .. } => {}
+        }
+    }
+
+    pub(super) fn action(&mut self, action: Action) {
+        match action {
+            Action::LoadStored => self.live = self.stored,
+            Action::LoadDefaults => self.live = FACTORY,
+            Action::Store => {
+                // System-mode bit 3 is not stored.
+                let compensation = self.stored.system_mode.gyro_compensation();
+                self.stored = self.live;
+                self.stored.system_mode =
+                    self.stored.system_mode.with_gyro_compensation(compensation);
+            }
+            Action::GyroCompensationOff => {
+                self.live.system_mode = self.live.system_mode.with_gyro_compensation(false);
+            }
+            Action::GyroCompensationOn | Action::RecalibrateGyro => {
+                self.live.system_mode = self.live.system_mode.with_gyro_compensation(true);
+                self.start_calibration();
+            }
+            Action::Unknown(_) => {}
+        }
+    }
+
+    pub(super) fn start_calibration(&mut self) {
+        self.calibrating_until_ms = Some(self.now_ms.saturating_add(CALIBRATION_MS));
+    }
+}
