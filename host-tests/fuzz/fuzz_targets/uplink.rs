@@ -22,7 +22,10 @@ fuzz_target!(|input: (Vec<u8>, Vec<u8>)| {
     let mut by_byte = Vec::new();
     for (i, b) in bytes.iter().enumerate() {
         if let Some(command) = one.push(*b) {
-            assert_eq!(Command::decode(&command.clone().encode()), Ok(command.clone()));
+            assert_eq!(
+                Command::decode(&command.clone().encode()),
+                Ok(command.clone())
+            );
             by_byte.push(command);
         }
         accounted(&one, i + 1, &by_byte);
