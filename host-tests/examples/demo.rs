@@ -116,6 +116,11 @@ fn drive_the_simulator() -> Result<(), Error<core::convert::Infallible>> {
         board.total_turn_commanded() as f32 / 10.0
     );
     let remaining = driver.turn_remaining()?;
+    // A second with nothing asked of the board: its telemetry runs unpaused, rates settle.
+    let until = time.get() + 1_100;
+    while time.get() < until {
+        driver.poll()?;
+    }
     let core = driver.core();
     println!(
         "  pending angle now {remaining} (0.1 deg); IMU at {} Hz, encoders at {} Hz; reply timeout {} ms; failsafe {} ms",
