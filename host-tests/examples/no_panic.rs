@@ -57,7 +57,7 @@ fn decode_command(bytes: &[u8]) -> Option<Command> {
 }
 
 #[no_panic]
-fn encode_command(command: &Command) -> CommandBytes {
+fn encode_command(command: Command) -> CommandBytes {
     command.encode()
 }
 
@@ -93,7 +93,7 @@ fn main() {
             frames += encode_telemetry(&t).len();
         }
         if let Some(c) = decode_command(&window[..12]) {
-            frames += encode_command(&c).len();
+            frames += encode_command(c).len();
         }
     }
     frames += encode_velocity(black_box(1), black_box(-2), black_box(3)).len();
