@@ -6,7 +6,7 @@ use chassis_host_tests::{BoardStream, score_downlink};
 use chassis_protocol::driver::{Config, CoreError, Error, blocking::Driver};
 use chassis_protocol::sim::{Board, SimClock, SimConfig, SimUart};
 use chassis_protocol::{
-    Action, DownlinkParser, DriveType, Motors, Register, Setting, SystemMode, Telemetry, Turn,
+    Action, Downlink, DownlinkParser, DriveType, Motors, Register, Setting, SystemMode, Turn,
     Velocity, Write,
 };
 use core::cell::Cell;
@@ -66,7 +66,7 @@ fn main() {
     let (bytes, sent) = BoardStream::new(2026, 2.0).take(255);
     let rx = transmit(&bytes, &Noise::mixed(1e-3), &mut Pcg64Mcg::seed_from_u64(1));
     let mut parser = DownlinkParser::new();
-    let frames: Vec<Telemetry> = parser.frames(&rx.bytes).collect();
+    let frames: Vec<Downlink> = parser.frames(&rx.bytes).collect();
     for frame in frames.iter().take(6) {
         println!("  {frame:?}");
     }

@@ -10,13 +10,13 @@
 //! ```
 
 use chassis_protocol::{
-    Command, CommandBytes, DownlinkParser, Telemetry, TelemetryBytes, UplinkParser, Velocity,
+    Command, CommandBytes, Downlink, DownlinkBytes, DownlinkParser, UplinkParser, Velocity,
 };
 use no_panic::no_panic;
 use std::hint::black_box;
 
 #[no_panic]
-fn downlink_push(parser: &mut DownlinkParser, byte: u8) -> Option<Telemetry> {
+fn downlink_push(parser: &mut DownlinkParser, byte: u8) -> Option<Downlink> {
     parser.push(byte)
 }
 
@@ -24,12 +24,12 @@ fn downlink_push(parser: &mut DownlinkParser, byte: u8) -> Option<Telemetry> {
 fn downlink_push_slice<'a>(
     parser: &mut DownlinkParser,
     bytes: &'a [u8],
-) -> (Option<Telemetry>, &'a [u8]) {
+) -> (Option<Downlink>, &'a [u8]) {
     parser.push_slice(bytes)
 }
 
 #[no_panic]
-fn downlink_idle(parser: &mut DownlinkParser) -> Option<Telemetry> {
+fn downlink_idle(parser: &mut DownlinkParser) -> Option<Downlink> {
     parser.idle()
 }
 
@@ -47,8 +47,8 @@ fn uplink_push_slice<'a>(
 }
 
 #[no_panic]
-fn decode_telemetry(bytes: &[u8]) -> Option<Telemetry> {
-    Telemetry::decode(bytes).ok()
+fn decode_telemetry(bytes: &[u8]) -> Option<Downlink> {
+    Downlink::decode(bytes).ok()
 }
 
 #[no_panic]
@@ -62,7 +62,7 @@ fn encode_command(command: Command) -> CommandBytes {
 }
 
 #[no_panic]
-fn encode_telemetry(frame: &Telemetry) -> TelemetryBytes {
+fn encode_telemetry(frame: &Downlink) -> DownlinkBytes {
     frame.encode()
 }
 

@@ -6,7 +6,7 @@
 //! line between them: the hardest case for resynchronisation, since a quiet line would mark
 //! every boundary.
 
-use chassis_protocol::{Battery, Encoders, Imu, Register, Reply, Telemetry};
+use chassis_protocol::{Battery, Downlink, Encoders, Imu, Register, Reply};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -16,7 +16,7 @@ pub struct SentFrame {
     /// Offset of its first byte in the sent stream.
     pub start: usize,
     /// The frame.
-    pub frame: Telemetry,
+    pub frame: Downlink,
 }
 
 impl SentFrame {
@@ -84,7 +84,7 @@ impl BoardStream {
         *slot
     }
 
-    fn imu(&mut self) -> Telemetry {
+    fn imu(&mut self) -> Downlink {
         let accel = [
             self.around_zero(40),
             self.around_zero(40),
@@ -95,36 +95,36 @@ impl BoardStream {
             self.around_zero(8),
             self.around_zero(8),
         ];
-        Telemetry::Imu(Imu {
+        Downlink::Imu(Imu {
             accel,
             gyro,
             seq: self.next_seq(0),
         })
     }
 
-    fn encoders(&mut self) -> Telemetry {
+    fn encoders(&mut self) -> Downlink {
         for wheel in 0..4 {
             let change = self.around_zero(3);
             self.wheel_speed[wheel] = (self.wheel_speed[wheel] + change).clamp(-40, 40);
             self.wheel_total[wheel] = self.wheel_total[wheel].wrapping_add(self.wheel_speed[wheel]);
         }
-        Telemetry::Encoders(Encoders {
+        Downlink::Encoders(Encoders {
             ticks: self.wheel_total,
             seq: self.next_seq(1),
         })
     }
 
-    fn battery(&mut self) -> Telemetry {
+    fn battery(&mut self) -> Downlink {
         self.centivolts = self.centivolts.saturating_sub(self.rng.random_range(0..2));
         let percent = (self.centivolts.saturating_sub(1_050) / 2).min(100);
-        Telemetry::Battery(Battery {
+        Downlink::Battery(Battery {
             centivolts: self.centivolts,
             percent,
             seq: self.next_seq(2),
         })
     }
 
-    fn reply(&mut self) -> Telemetry {
+    fn reply(&mut self) -> Downlink {
         let register = Register::ALL[self.rng.random_range(0..Register::ALL.len())];
         let value = match register {
             Register::PendingAngle => self.rng.random_range(-1_800i32..=1_800) as u32,
@@ -133,11 +133,11 @@ impl BoardStream {
             Register::MotorVoltage => 1_200,
             _ => self.rng.random_range(0..100_000),
         };
-        Telemetry::Reply(Reply::new(register, value))
+        Downlink::Reply(Reply::new(register, value))
     }
 
     /// The next frame the board sends, and advances time past it.
-    pub fn next_frame(&mut self) -> Telemetry {
+    pub fn next_frame(&mut self) -> Downlink {
         let due = self
             .next_imu_us
             .min(self.next_encoders_us)
@@ -227,7 +227,7 @@ pub fn simulator_bursts(seed: u64, count: usize) -> (Vec<u8>, Vec<SentFrame>, Ve
         let Some(raw) = bytes.get(at..at + kind.len()) else {
             break;
         };
-        let Ok(frame) = Telemetry::decode(raw) else {
+        let Ok(frame) = Downlink::decode(raw) else {
             break;
         };
         frames.push(SentFrame { start: at, frame });

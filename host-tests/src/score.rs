@@ -9,15 +9,15 @@
 
 use crate::board::SentFrame;
 use crate::channel::Received;
-use chassis_protocol::{DownlinkParser, DownlinkStats, Lock, Telemetry};
+use chassis_protocol::{Downlink, DownlinkParser, DownlinkStats, Lock};
 use std::collections::HashMap;
 
 /// The figures of one run.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Score {
-    /// Frames sent.
+    /// DownlinkFrames sent.
     pub sent: usize,
-    /// Frames the channel left untouched.
+    /// DownlinkFrames the channel left untouched.
     pub untouched: usize,
     /// Untouched frames emitted equal at their place.
     pub recalled: usize,
@@ -92,7 +92,7 @@ pub fn score_downlink(sent: &[SentFrame], rx: &Received) -> Score {
     };
     let mut parser = DownlinkParser::new();
 
-    let mut judge = |frame: Telemetry, end: usize, now: usize, locked: bool, score: &mut Score| {
+    let mut judge = |frame: Downlink, end: usize, now: usize, locked: bool, score: &mut Score| {
         let len = frame.encode().len();
         let start = (end + 1).saturating_sub(len);
         let place = rx
@@ -195,14 +195,14 @@ fn starts(streams: impl Iterator<Item = (Vec<u8>, Vec<SentFrame>, Vec<usize>)>) 
                 .position(|f| f.start >= offset)
                 .unwrap_or(sent.len());
             let mut parser = DownlinkParser::new();
-            let mut out: Vec<Telemetry> = Vec::new();
+            let mut out: Vec<Downlink> = Vec::new();
             let mut from = offset;
             for &end in quiet_at.iter().filter(|end| **end > offset) {
                 out.extend(parser.frames(&bytes[from..end]));
                 out.extend(std::iter::from_fn(|| parser.idle()));
                 from = end;
             }
-            let expected: Vec<Telemetry> = sent[first..].iter().map(|f| f.frame).collect();
+            let expected: Vec<Downlink> = sent[first..].iter().map(|f| f.frame).collect();
             figures.add_start(&out, &expected);
         }
     }
@@ -211,7 +211,7 @@ fn starts(streams: impl Iterator<Item = (Vec<u8>, Vec<SentFrame>, Vec<usize>)>) 
 
 impl Startup {
     /// Counts one start: what the parser emitted against the frames from the first complete one.
-    fn add_start(&mut self, out: &[Telemetry], expected: &[Telemetry]) {
+    fn add_start(&mut self, out: &[Downlink], expected: &[Downlink]) {
         let false_frames = out.iter().filter(|f| !expected.contains(f)).count();
         let lost = expected.iter().skip(1).filter(|f| !out.contains(f)).count();
         self.starts += 1;

@@ -8,7 +8,7 @@
 
 use crate::BoardStream;
 use chassis_protocol::parse::downlink::FORGET_AFTER;
-use chassis_protocol::{DownlinkParser, Lock, Telemetry};
+use chassis_protocol::{Downlink, DownlinkParser, Lock};
 
 /// `FORGET_AFTER` (the longest a false count learnt from the corruption can hold out) plus three
 /// of the longest frames; on most inputs recovery takes one or two frames.
@@ -48,7 +48,7 @@ pub fn check_recovery(splice: &Splice<'_>) -> Result<(), String> {
     let shift = |sent_offset: usize| sent_offset + garbage.len() - cut;
 
     let mut parser = DownlinkParser::new();
-    let mut out: Vec<(usize, Telemetry)> = Vec::new();
+    let mut out: Vec<(usize, Downlink)> = Vec::new();
     for (i, b) in wire.iter().enumerate() {
         if let Some(frame) = parser.push(*b) {
             out.push((i, frame));

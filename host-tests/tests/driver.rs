@@ -2,10 +2,10 @@
 //! clock (1 ms per clock reading): every command, every setting written and read back, the
 //! one-shot turn, the failsafe, the reply timeout, telemetry rates, the settings snapshot.
 
-use chassis_protocol::driver::{Config, CoreError, Error, Event, Settings, blocking::Driver, reg};
+use chassis_protocol::driver::{Config, CoreError, Error, Event, Snapshot, blocking::Driver, reg};
 use chassis_protocol::sim::{Board, FACTORY, Faults, Motion, SimClock, SimConfig, SimUart};
 use chassis_protocol::{
-    Action, DriveType, Motors, Register, Stream, SystemMode, Telemetry, Velocity, Write,
+    Action, Downlink, DriveType, Motors, Register, Stream, SystemMode, Velocity, Write,
 };
 use core::cell::Cell;
 use core::convert::Infallible;
@@ -18,7 +18,7 @@ fn driver(time: &Cell<u64>) -> SimDriver<'_> {
 }
 
 /// Polls for `ms` milliseconds of simulated time, collecting telemetry.
-fn run_for(d: &mut SimDriver<'_>, time: &Cell<u64>, ms: u64) -> Vec<Telemetry> {
+fn run_for(d: &mut SimDriver<'_>, time: &Cell<u64>, ms: u64) -> Vec<Downlink> {
     let end = time.get() + ms;
     let mut frames = Vec::new();
     while time.get() < end {
@@ -271,7 +271,7 @@ fn replies_interleave_with_telemetry_on_a_noisy_line() {
         run_for(&mut d, &time, 20);
     }
     assert!(ok >= 198, "{ok} of 200 verified reads answered");
-    // Telemetry paused while the reads went on (A6) and resumes 100 ms after the last one: of
+    // Downlink paused while the reads went on (A6) and resumes 100 ms after the last one: of
     // the next 300 ms (the last read was 20 ms ago), 80 are still quiet, 220 carry 22 IMU frames.
     let before = d.core().stream(Stream::Imu).frames;
     run_for(&mut d, &time, 300);
@@ -296,12 +296,12 @@ fn the_settings_snapshot_reads_in_one_call_and_serialises_with_postcard() {
 
     let mut buf = [0u8; 64];
     let bytes = postcard::to_slice(&settings, &mut buf).unwrap();
-    let back: Settings = postcard::from_bytes(bytes).unwrap();
+    let back: Snapshot = postcard::from_bytes(bytes).unwrap();
     assert_eq!(back, settings);
     let mut buf = [0u8; 64];
     let framed = postcard::to_slice_cobs(&settings, &mut buf).unwrap();
     assert!(!framed[..framed.len() - 1].contains(&0));
-    let back: Settings = postcard::from_bytes_cobs(framed).unwrap();
+    let back: Snapshot = postcard::from_bytes_cobs(framed).unwrap();
     assert_eq!(back, settings);
 
     // Restore on a fresh board.

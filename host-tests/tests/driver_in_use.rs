@@ -8,7 +8,7 @@ use chassis_protocol::driver::asynch::Driver as AsyncDriver;
 use chassis_protocol::driver::blocking::Driver;
 use chassis_protocol::driver::nb::{NbError, NbSerial};
 use chassis_protocol::driver::{
-    Config, CoreError, DriverCore, Error, Event, Outcome, Request, Settings, reg,
+    Config, CoreError, DriverCore, Error, Event, Outcome, Request, Snapshot, reg,
 };
 use chassis_protocol::sim::{
     Board, FACTORY, Faults, Motion, SimClock, SimConfig, SimDelay, SimUart,
@@ -348,7 +348,7 @@ fn bug4_a_reply_that_does_not_fit_its_register_is_an_error() {
 fn bug5_restoring_settings_never_starts_a_calibration() {
     let time = Cell::new(0);
     let mut d = sim_driver(&time, SimConfig::default());
-    let mut snapshot: Settings = FACTORY;
+    let mut snapshot: Snapshot = FACTORY;
     snapshot.max_speed = 777;
     snapshot.system_mode =
         SystemMode::new(chassis_protocol::DriveType::Omni).with_gyro_compensation(true);
@@ -579,7 +579,7 @@ fn every_request_ends_with_an_outcome_and_leaves_the_core_free() {
     let time = Cell::new(0);
     let mut d = sim_driver(&time, SimConfig::default());
     let settings = match d.run(Request::ReadSettings).unwrap() {
-        Outcome::Settings(s) => s,
+        Outcome::Snapshot(s) => s,
         other => panic!("{other:?}"),
     };
     assert_eq!(settings, FACTORY);

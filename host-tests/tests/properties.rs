@@ -6,8 +6,8 @@ use chassis_host_tests::channel::{Noise, transmit};
 use chassis_host_tests::{BoardStream, pieces};
 use chassis_protocol::parse::downlink::FORGET_AFTER;
 use chassis_protocol::{
-    Action, Battery, Command, DownlinkParser, Encoders, Imu, Kind, Lock, Motors, Register, Reply,
-    Setting, SystemMode, Telemetry, Turn, UplinkParser, Velocity, Write,
+    Action, Battery, Command, Downlink, DownlinkParser, Encoders, Imu, Kind, Lock, Motors,
+    Register, Reply, Setting, SystemMode, Turn, UplinkParser, Velocity, Write,
 };
 use proptest::prelude::*;
 use rand::SeedableRng;
@@ -51,34 +51,34 @@ fn command() -> impl Strategy<Value = Command> {
     ]
 }
 
-fn telemetry() -> impl Strategy<Value = Telemetry> {
+fn telemetry() -> impl Strategy<Value = Downlink> {
     prop_oneof![
         (any::<[i16; 3]>(), any::<[i16; 3]>(), any::<u8>())
-            .prop_map(|(accel, gyro, seq)| Telemetry::Imu(Imu { accel, gyro, seq })),
+            .prop_map(|(accel, gyro, seq)| Downlink::Imu(Imu { accel, gyro, seq })),
         (any::<[i16; 4]>(), any::<u8>())
-            .prop_map(|(ticks, seq)| Telemetry::Encoders(Encoders { ticks, seq })),
+            .prop_map(|(ticks, seq)| Downlink::Encoders(Encoders { ticks, seq })),
         (any::<u16>(), any::<u16>(), any::<u8>()).prop_map(|(centivolts, percent, seq)| {
-            Telemetry::Battery(Battery {
+            Downlink::Battery(Battery {
                 centivolts,
                 percent,
                 seq,
             })
         }),
         (any::<u8>(), any::<u32>())
-            .prop_map(|(code, value)| Telemetry::Reply(Reply { code, value })),
+            .prop_map(|(code, value)| Downlink::Reply(Reply { code, value })),
     ]
 }
 
 /// A stream's frames the simple way: from a boundary, header, length, decode, next. `None` as
 /// soon as a header is not one: only right for clean streams that start at a boundary.
-fn reference_parse(mut bytes: &[u8]) -> Option<Vec<Telemetry>> {
+fn reference_parse(mut bytes: &[u8]) -> Option<Vec<Downlink>> {
     let mut frames = Vec::new();
     while !bytes.is_empty() {
         let kind = match bytes {
             [a, b, ..] => Kind::from_header(*a, *b)?,
             _ => return None,
         };
-        let frame = Telemetry::decode(bytes.get(..kind.len())?).ok()?;
+        let frame = Downlink::decode(bytes.get(..kind.len())?).ok()?;
         frames.push(frame);
         bytes = &bytes[kind.len()..];
     }
@@ -94,8 +94,8 @@ fn cases() -> u32 {
         .unwrap_or(512)
 }
 
-fn parse_all(parser: &mut DownlinkParser, bytes: &[u8]) -> Vec<Telemetry> {
-    let mut out: Vec<Telemetry> = parser.frames(bytes).collect();
+fn parse_all(parser: &mut DownlinkParser, bytes: &[u8]) -> Vec<Downlink> {
+    let mut out: Vec<Downlink> = parser.frames(bytes).collect();
     out.extend(std::iter::from_fn(|| parser.idle()));
     out
 }
@@ -119,7 +119,7 @@ proptest! {
     #[test]
     fn every_telemetry_frame_round_trips(frame in telemetry()) {
         let bytes = frame.encode();
-        prop_assert_eq!(Telemetry::decode(&bytes), Ok(frame));
+        prop_assert_eq!(Downlink::decode(&bytes), Ok(frame));
     }
 
     /// Any bytes of a frame's layout decode, and encode back to exactly those bytes: reserved
@@ -152,7 +152,7 @@ proptest! {
             bytes[1] = code;
         }
         bytes.extend_from_slice(&body[..len - 2]);
-        let frame = Telemetry::decode(&bytes).unwrap();
+        let frame = Downlink::decode(&bytes).unwrap();
         let encoded = frame.encode();
         prop_assert_eq!(encoded.as_slice(), &bytes[..]);
     }
@@ -167,7 +167,7 @@ proptest! {
         let (bytes, _) = BoardStream::new(seed, 5.0).take(60);
         let rx = transmit(&bytes, &Noise::mixed(rate), &mut Pcg64Mcg::seed_from_u64(seed));
         let mut one = DownlinkParser::new();
-        let mut expected: Vec<Telemetry> = rx.bytes.iter().filter_map(|b| one.push(*b)).collect();
+        let mut expected: Vec<Downlink> = rx.bytes.iter().filter_map(|b| one.push(*b)).collect();
         expected.extend(std::iter::from_fn(|| one.idle()));
 
         let mut chunked = DownlinkParser::new();
@@ -215,8 +215,8 @@ proptest! {
         let mut parser = DownlinkParser::new();
         let out = parse_all(&mut parser, &bytes);
         let doubtful_first = match reference[0] {
-            Telemetry::Battery(_) => true,
-            Telemetry::Reply(r) => r.encode()[2..].windows(2).any(|w| w[0] == 0xFF && (0xFA..=0xFC).contains(&w[1])),
+            Downlink::Battery(_) => true,
+            Downlink::Reply(r) => r.encode()[2..].windows(2).any(|w| w[0] == 0xFF && (0xFA..=0xFC).contains(&w[1])),
             _ => false,
         };
         if doubtful_first && out.first() != reference.first() {

@@ -4,7 +4,7 @@
 //! The stream is written out by hand, byte for byte from the spec tables (2C, 2D, 2E), and so
 //! are the frames expected from it: nothing here comes from the encoders under test.
 
-use chassis_protocol::{Battery, DownlinkParser, Encoders, Imu, Lock, Reply, Telemetry};
+use chassis_protocol::{Battery, Downlink, DownlinkParser, Encoders, Imu, Lock, Reply};
 
 /// Ten frames: IMU, encoders, battery and replies, with `FF FA`/`FF FB`/`FF FC` and `23 xx`
 /// (with valid reply codes) inside the payloads.
@@ -45,50 +45,50 @@ const STREAM: &[&[u8]] = &[
     ],
 ];
 
-fn expected() -> Vec<Telemetry> {
+fn expected() -> Vec<Downlink> {
     vec![
-        Telemetry::Imu(Imu {
+        Downlink::Imu(Imu {
             accel: [16, -6, 16384],
             gyro: [-6, -5, 0x2309],
             seq: 5,
         }),
-        Telemetry::Encoders(Encoders {
+        Downlink::Encoders(Encoders {
             ticks: [1, -4, 0x2301, -1],
             seq: 7,
         }),
-        Telemetry::Imu(Imu {
+        Downlink::Imu(Imu {
             accel: [17, -6, 16385],
             gyro: [0, -6, 0],
             seq: 6,
         }),
-        Telemetry::Reply(Reply {
+        Downlink::Reply(Reply {
             code: 0x20,
             value: 0xFFFF_FC7C,
         }),
-        Telemetry::Imu(Imu {
+        Downlink::Imu(Imu {
             accel: [-1, -2, 16383],
             gyro: [1, 2, -4],
             seq: 7,
         }),
-        Telemetry::Battery(Battery {
+        Downlink::Battery(Battery {
             centivolts: 1100,
             percent: 87,
             seq: 0,
         }),
-        Telemetry::Imu(Imu {
+        Downlink::Imu(Imu {
             accel: [0, 0, 16384],
             gyro: [0x230C, -6, -5],
             seq: 8,
         }),
-        Telemetry::Encoders(Encoders {
+        Downlink::Encoders(Encoders {
             ticks: [2, -4, 0x2302, -2],
             seq: 8,
         }),
-        Telemetry::Reply(Reply {
+        Downlink::Reply(Reply {
             code: 0x09,
             value: 1,
         }),
-        Telemetry::Imu(Imu {
+        Downlink::Imu(Imu {
             accel: [18, -6, 16386],
             gyro: [-6, -5, -4],
             seq: 9,
@@ -101,12 +101,12 @@ const ROUNDS: usize = 5;
 
 /// The count each frame of round `round` carries: every stream's count runs on across rounds
 /// (IMU 5..=9 and encoders 7..=8 in round 0, battery 0; replies have none).
-fn seq_in_round(frame: &Telemetry, round: usize) -> Option<u8> {
+fn seq_in_round(frame: &Downlink, round: usize) -> Option<u8> {
     let per_round = match frame {
-        Telemetry::Imu(_) => 5,
-        Telemetry::Encoders(_) => 2,
-        Telemetry::Battery(_) => 1,
-        Telemetry::Reply(_) => return None,
+        Downlink::Imu(_) => 5,
+        Downlink::Encoders(_) => 2,
+        Downlink::Battery(_) => 1,
+        Downlink::Reply(_) => return None,
     };
     frame
         .seq()
@@ -120,16 +120,16 @@ fn stream() -> Vec<u8> {
 
 /// `ROUNDS` rounds of the ten frames, each frame's count byte (its last byte, per 2E) set to
 /// run on, so that every stream has a count history: (frames, bytes).
-fn long_stream() -> (Vec<Telemetry>, Vec<u8>) {
+fn long_stream() -> (Vec<Downlink>, Vec<u8>) {
     let mut frames = Vec::new();
     let mut bytes = Vec::new();
     for round in 0..ROUNDS {
         for (raw, frame) in STREAM.iter().zip(expected()) {
             let mut raw = raw.to_vec();
             let frame = match (frame, seq_in_round(&frame, round)) {
-                (Telemetry::Imu(f), Some(seq)) => Telemetry::Imu(Imu { seq, ..f }),
-                (Telemetry::Encoders(f), Some(seq)) => Telemetry::Encoders(Encoders { seq, ..f }),
-                (Telemetry::Battery(f), Some(seq)) => Telemetry::Battery(Battery { seq, ..f }),
+                (Downlink::Imu(f), Some(seq)) => Downlink::Imu(Imu { seq, ..f }),
+                (Downlink::Encoders(f), Some(seq)) => Downlink::Encoders(Encoders { seq, ..f }),
+                (Downlink::Battery(f), Some(seq)) => Downlink::Battery(Battery { seq, ..f }),
                 (other, _) => other,
             };
             if let (Some(last), Some(seq)) = (raw.last_mut(), frame.seq()) {
@@ -156,7 +156,7 @@ fn starts() -> Vec<usize> {
 }
 
 /// Runs `bytes` through a parser in chunks of `chunk` bytes, then tells it the line went idle.
-fn parse_chunked(parser: &mut DownlinkParser, bytes: &[u8], chunk: usize) -> Vec<Telemetry> {
+fn parse_chunked(parser: &mut DownlinkParser, bytes: &[u8], chunk: usize) -> Vec<Downlink> {
     let mut out = Vec::new();
     for piece in bytes.chunks(chunk) {
         out.extend(parser.frames(piece));
@@ -165,8 +165,8 @@ fn parse_chunked(parser: &mut DownlinkParser, bytes: &[u8], chunk: usize) -> Vec
     out
 }
 
-fn parse_bytewise(parser: &mut DownlinkParser, bytes: &[u8]) -> Vec<Telemetry> {
-    let mut out: Vec<Telemetry> = bytes.iter().filter_map(|b| parser.push(*b)).collect();
+fn parse_bytewise(parser: &mut DownlinkParser, bytes: &[u8]) -> Vec<Downlink> {
+    let mut out: Vec<Downlink> = bytes.iter().filter_map(|b| parser.push(*b)).collect();
     out.extend(std::iter::from_fn(|| parser.idle()));
     out
 }
@@ -174,7 +174,7 @@ fn parse_bytewise(parser: &mut DownlinkParser, bytes: &[u8]) -> Vec<Telemetry> {
 #[test]
 fn the_hand_written_frames_decode_one_by_one() {
     for (bytes, frame) in STREAM.iter().zip(expected()) {
-        assert_eq!(Telemetry::decode(bytes), Ok(frame));
+        assert_eq!(Downlink::decode(bytes), Ok(frame));
         assert_eq!(frame.encode().as_slice(), *bytes);
     }
 }
@@ -203,7 +203,7 @@ fn every_split_point_of_two_reads() {
     for split in 0..=bytes.len() {
         let (a, b) = bytes.split_at(split);
         let mut parser = DownlinkParser::new();
-        let mut out: Vec<Telemetry> = parser.frames(a).collect();
+        let mut out: Vec<Downlink> = parser.frames(a).collect();
         out.extend(parser.frames(b));
         out.extend(std::iter::from_fn(|| parser.idle()));
         assert_eq!(out, expected(), "split at {split}");
@@ -242,7 +242,7 @@ fn while_locked_frames_come_out_on_their_last_byte() {
 /// How many frames after `frames[from]` the parser needs to recover in `out`: the smallest `r`
 /// such that every frame from `frames[from + r]` on is in `out`, and nothing false comes out from
 /// there on. `None` if it never recovers.
-fn frames_to_recover(out: &[Telemetry], frames: &[Telemetry], from: usize) -> Option<usize> {
+fn frames_to_recover(out: &[Downlink], frames: &[Downlink], from: usize) -> Option<usize> {
     (from..frames.len()).map(|i| i - from).find(|r| {
         let i = from + r;
         let all_there = frames[i..].iter().all(|f| out.contains(f));
@@ -343,7 +343,7 @@ fn a_truncated_frame_in_mid_stream_is_recovered_from_within_a_bound() {
             let what = format!("frame {k} cut at {cut}");
             // Frame k itself may come out at its place with the next frame's first bytes in
             // it (there is no checksum); that is a damaged frame, not a false one.
-            let out: Vec<Telemetry> = out
+            let out: Vec<Downlink> = out
                 .into_iter()
                 .filter(|f| f.kind() != frames[k].kind() || frames.contains(f))
                 .collect();
@@ -356,7 +356,7 @@ fn a_truncated_frame_in_mid_stream_is_recovered_from_within_a_bound() {
             );
             let r = frames_to_recover(&out, &frames, k + 1);
             let bound = match frames[k] {
-                Telemetry::Reply(_) => TRUNCATED_REPLY_BOUND,
+                Downlink::Reply(_) => TRUNCATED_REPLY_BOUND,
                 _ => TRUNCATION_BOUND,
             };
             assert!(
@@ -372,16 +372,16 @@ fn a_reply_after_a_quiet_line_comes_out_at_once_and_a_false_battery_at_one_does_
     // The board stops telemetry while settings are made (A6): the line goes quiet, then a reply
     // comes alone. The quiet line is a frame boundary: the reply comes out on its last byte.
     let reply = [0x23u8, 0x0B, 0x00, 0x00, 0x04, 0xB0];
-    let expected = Telemetry::Reply(Reply {
+    let expected = Downlink::Reply(Reply {
         code: 0x0B,
         value: 1200,
     });
     let mut parser = DownlinkParser::new();
     assert_eq!(parser.idle(), None);
-    let got: Vec<Telemetry> = parser.frames(&reply).collect();
+    let got: Vec<Downlink> = parser.frames(&reply).collect();
     assert_eq!(got, vec![expected]);
     assert_eq!(parser.idle(), None);
-    let got: Vec<Telemetry> = parser.frames(&reply).collect();
+    let got: Vec<Downlink> = parser.frames(&reply).collect();
     assert_eq!(got, vec![expected]);
 
     // A parser that saw no quiet line before it cannot tell a battery frame from the tail of an
@@ -398,7 +398,7 @@ fn a_reply_after_a_quiet_line_comes_out_at_once_and_a_false_battery_at_one_does_
     // The same bytes from the frame's start, after a quiet line: the IMU frame, nothing else.
     assert_eq!(parser.frames(&imu).count(), 0);
     match parser.idle() {
-        Some(Telemetry::Imu(got)) => assert_eq!((got.gyro, got.seq), ([-4, 3, 1], 0x2A)),
+        Some(Downlink::Imu(got)) => assert_eq!((got.gyro, got.seq), ([-4, 3, 1], 0x2A)),
         other => panic!("{other:?}"),
     }
     assert_eq!(parser.idle(), None);

@@ -4,7 +4,7 @@
 //! that `decode` can return: reserved bits and negative zeros are where `decode` puts them, and
 //! a setting that fits a typed form is never `Setting::Raw`. Hence encode → decode is exact.
 
-use crate::{Battery, Command, Encoders, Imu, Motors, Reply, Setting, Telemetry, Turn, Velocity};
+use crate::{Battery, Command, Downlink, Encoders, Imu, Motors, Reply, Setting, Turn, Velocity};
 use arbitrary::{Arbitrary, Result, Unstructured};
 
 /// `N` bytes: `head`, then arbitrary bytes, then `fix` applied.
@@ -131,13 +131,13 @@ impl<'a> Arbitrary<'a> for Reply {
     }
 }
 
-impl<'a> Arbitrary<'a> for Telemetry {
+impl<'a> Arbitrary<'a> for Downlink {
     fn arbitrary(u: &mut Unstructured<'a>) -> Result<Self> {
         Ok(match u.int_in_range(0u8..=3)? {
-            0 => Telemetry::Imu(u.arbitrary()?),
-            1 => Telemetry::Encoders(u.arbitrary()?),
-            2 => Telemetry::Battery(u.arbitrary()?),
-            _ => Telemetry::Reply(u.arbitrary()?),
+            0 => Downlink::Imu(u.arbitrary()?),
+            1 => Downlink::Encoders(u.arbitrary()?),
+            2 => Downlink::Battery(u.arbitrary()?),
+            _ => Downlink::Reply(u.arbitrary()?),
         })
     }
 }
@@ -154,11 +154,11 @@ mod tests {
         let mut u = Unstructured::new(&data);
         let mut made = 0;
         while !u.is_empty() {
-            let (Ok(c), Ok(t)) = (Command::arbitrary(&mut u), Telemetry::arbitrary(&mut u)) else {
+            let (Ok(c), Ok(t)) = (Command::arbitrary(&mut u), Downlink::arbitrary(&mut u)) else {
                 break;
             };
             assert_eq!(Command::decode(&c.clone().encode()), Ok(c));
-            assert_eq!(Telemetry::decode(&t.encode()), Ok(t));
+            assert_eq!(Downlink::decode(&t.encode()), Ok(t));
             made += 1;
         }
         assert!(made > 50, "{made}");

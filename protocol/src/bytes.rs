@@ -5,7 +5,7 @@ use crate::wire;
 /// The encoded bytes of a frame of up to `N` bytes: a fixed buffer and the used length.
 ///
 /// Returned by [`Command::encode`](crate::Command::encode) and
-/// [`Telemetry::encode`](crate::Telemetry::encode), whose frame types differ in length. It
+/// [`Downlink::encode`](crate::Downlink::encode), whose frame types differ in length. It
 /// dereferences to `&[u8]`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

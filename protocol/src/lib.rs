@@ -1,11 +1,11 @@
-//! Frames and streaming parsers for the chassis motor-controller board's UART protocol.
+//! DownlinkFrames and streaming parsers for the chassis motor-controller board's UART protocol.
 //!
 //! `no_std`, no allocation, no `unsafe`, no panic on any input. The same crate runs on the
 //! microcontroller that drives the chassis, on a Linux host behind a USB-UART adapter, in the
 //! board simulator and under the fuzzer.
 //!
 //! ```
-//! use chassis_protocol::{DownlinkParser, Imu, Telemetry, Turn, Velocity};
+//! use chassis_protocol::{DownlinkParser, Imu, Downlink, Turn, Velocity};
 //!
 //! // Master → board: fixed-size frames, built without a parser.
 //! let drive: [u8; 10] = Velocity::new(0, 300, 0).encode();
@@ -19,9 +19,9 @@
 //! for seq in 0..3 {
 //!     wire.extend_from_slice(&Imu { accel: [0, 0, 16_384], gyro: [0, 0, -6], seq }.encode());
 //! }
-//! let frames: Vec<Telemetry> = parser.frames(&wire).collect();
+//! let frames: Vec<Downlink> = parser.frames(&wire).collect();
 //! assert_eq!(frames.len(), 3);
-//! assert!(matches!(frames[2], Telemetry::Imu(Imu { seq: 2, .. })));
+//! assert!(matches!(frames[2], Downlink::Imu(Imu { seq: 2, .. })));
 //! ```
 //!
 //! # Map
@@ -31,7 +31,7 @@
 //! | [`command`] | master → board: [`Velocity`], [`Turn`], [`Motors`], [`Setting`] ([`Action`], [`Write`], [`Register`] reads), [`SystemMode`] |
 //! | [`telemetry`] | board → master: [`Imu`], [`Encoders`], [`Battery`], [`Reply`] |
 //! | [`parse`] | [`DownlinkParser`] (board → master), [`UplinkParser`] (master → board), their counters |
-//! | [`registers`] | [`Settings`]: a snapshot of every readable register |
+//! | [`registers`] | [`Snapshot`]: a snapshot of every readable register |
 //! | [`units`] | conversions where the spec states the unit |
 //! | `driver` (feature) | the master-side driver: sans-IO core, blocking / `nb` / async shells |
 //! | `sim` (feature) | the board simulator |
@@ -100,5 +100,5 @@ pub use command::{
 };
 pub use error::Error;
 pub use parse::{DownlinkParser, DownlinkStats, Lock, UplinkParser, UplinkStats};
-pub use registers::Settings;
-pub use telemetry::{Battery, Encoders, Imu, Kind, Reply, Stream, Telemetry, TelemetryBytes};
+pub use registers::Snapshot;
+pub use telemetry::{Battery, Downlink, DownlinkBytes, Encoders, Imu, Kind, Reply, Stream};

@@ -1,15 +1,16 @@
-//! [`Settings`]: a snapshot of every readable register — what the driver reads in one call and
+//! [`Snapshot`]: a snapshot of every readable register — what the driver reads in one call and
 //! writes back in one call, and what the board simulator keeps (live and stored copies).
 
 use crate::command::{Register, SystemMode, Write};
 use crate::telemetry::Reply;
 
-/// A snapshot of the board's registers (2C). Serialises with `serde` (feature `serde`), e.g.
+/// A snapshot of the board's registers (2C): every readable setting (named `Snapshot`, not
+/// `Settings`, so that it is never mistaken for a [`Setting`](crate::Setting) frame). Serialises with `serde` (feature `serde`), e.g.
 /// with postcard's `to_slice` / `to_slice_cobs`, to keep a bring-up's settings in flash.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct Settings {
+pub struct Snapshot {
     /// `0x01`, unit not stated.
     pub max_speed: u16,
     /// `0x06`, raw.
@@ -30,8 +31,8 @@ pub struct Settings {
     pub battery_cutoff_centivolts: u16,
 }
 
-impl Settings {
-    /// The eight registers a snapshot holds. [`Settings::writes`] gives seven of them back, in
+impl Snapshot {
+    /// The eight registers a snapshot holds. [`Snapshot::writes`] gives seven of them back, in
     /// this order, leaving out the gyro calibration value.
     pub const REGISTERS: [Register; 8] = [
         Register::MaxSpeed,
@@ -44,7 +45,7 @@ impl Settings {
         Register::BatteryRange,
     ];
 
-    /// Takes in the reply to one of [`Settings::REGISTERS`]; `false` for any other reply, or a
+    /// Takes in the reply to one of [`Snapshot::REGISTERS`]; `false` for any other reply, or a
     /// value that does not fit its register.
     pub fn apply(&mut self, reply: &Reply) -> bool {
         match reply.as_write() {
@@ -249,7 +250,7 @@ mod tests {
 
     #[test]
     fn the_snapshot_lists_its_eight_registers_and_writes_seven() {
-        assert_eq!(Settings::REGISTERS.len(), 8);
-        assert_eq!(Settings::default().writes().len(), 7);
+        assert_eq!(Snapshot::REGISTERS.len(), 8);
+        assert_eq!(Snapshot::default().writes().len(), 7);
     }
 }

@@ -8,17 +8,17 @@
 #![no_main]
 
 use chassis_host_tests::pieces;
-use chassis_protocol::{DownlinkParser, Register, Telemetry};
+use chassis_protocol::{Downlink, DownlinkParser, Register};
 use libfuzzer_sys::fuzz_target;
 
-fn well_formed(frame: &Telemetry) {
-    assert_eq!(Telemetry::decode(&frame.encode()), Ok(*frame));
-    if let Telemetry::Reply(reply) = frame {
+fn well_formed(frame: &Downlink) {
+    assert_eq!(Downlink::decode(&frame.encode()), Ok(*frame));
+    if let Downlink::Reply(reply) = frame {
         assert!(Register::from_reply_code(reply.code).is_some(), "{reply:?}");
     }
 }
 
-fn accounted(parser: &DownlinkParser, fed: usize, emitted: &[Telemetry]) {
+fn accounted(parser: &DownlinkParser, fed: usize, emitted: &[Downlink]) {
     let in_frames: usize = emitted.iter().map(|f| f.encode().len()).sum();
     let stats = parser.stats();
     assert_eq!(

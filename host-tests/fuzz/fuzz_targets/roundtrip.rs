@@ -2,10 +2,10 @@
 //! direction's streaming parser on its own bytes.
 #![no_main]
 
-use chassis_protocol::{Command, DownlinkParser, Telemetry, UplinkParser};
+use chassis_protocol::{Command, Downlink, DownlinkParser, UplinkParser};
 use libfuzzer_sys::fuzz_target;
 
-fuzz_target!(|frames: (Command, Telemetry)| {
+fuzz_target!(|frames: (Command, Downlink)| {
     let (command, telemetry) = frames;
 
     let bytes = command.clone().encode();
@@ -15,14 +15,14 @@ fuzz_target!(|frames: (Command, Telemetry)| {
     assert_eq!(out, [command]);
 
     let bytes = telemetry.encode();
-    assert_eq!(Telemetry::decode(&bytes), Ok(telemetry));
-    let defined = !matches!(telemetry, Telemetry::Reply(r) if r.register().is_none());
+    assert_eq!(Downlink::decode(&bytes), Ok(telemetry));
+    let defined = !matches!(telemetry, Downlink::Reply(r) if r.register().is_none());
 
     // A lone frame between quiet lines comes out, but for a reply with a code the spec does not
     // define (the parser does not take those as replies).
     let mut downlink = DownlinkParser::new();
     assert_eq!(downlink.idle(), None);
-    let mut out: Vec<Telemetry> = downlink.frames(&bytes).collect();
+    let mut out: Vec<Downlink> = downlink.frames(&bytes).collect();
     out.extend(std::iter::from_fn(|| downlink.idle()));
     if defined {
         assert_eq!(out, [telemetry]);
@@ -34,9 +34,9 @@ fuzz_target!(|frames: (Command, Telemetry)| {
     // a frame: the same, but for a battery frame, which a quiet line after it does not prove
     // while no count is known (it could be an IMU frame's tail).
     let mut downlink = DownlinkParser::new();
-    let mut out: Vec<Telemetry> = downlink.frames(&bytes).collect();
+    let mut out: Vec<Downlink> = downlink.frames(&bytes).collect();
     out.extend(std::iter::from_fn(|| downlink.idle()));
-    if defined && !matches!(telemetry, Telemetry::Battery(_)) {
+    if defined && !matches!(telemetry, Downlink::Battery(_)) {
         assert_eq!(out, [telemetry]);
     } else {
         assert!(out.is_empty());

@@ -16,7 +16,7 @@ use super::{
     Clock, Config, CoreError, DriverCore, Error, Event, Outcome, Readable, Request, RxBuffer,
 };
 use crate::command::{Action, Motors, Register, Turn, Velocity, Write};
-use crate::registers::Settings;
+use crate::registers::Snapshot;
 use embassy_futures::select::{Either, select};
 use embedded_hal_async::delay::DelayNs;
 use embedded_io_async::{Read, Write as IoWrite};
@@ -175,16 +175,16 @@ where
         self.send(&bytes).await
     }
 
-    /// Reads every register of a [`Settings`] snapshot, each read verified.
-    pub async fn read_settings(&mut self) -> Result<Settings, Error<U::Error>> {
+    /// Reads every register of a [`Snapshot`] snapshot, each read verified.
+    pub async fn read_settings(&mut self) -> Result<Snapshot, Error<U::Error>> {
         match self.run(Request::ReadSettings).await? {
-            Outcome::Settings(settings) => Ok(settings),
-            _ => Ok(Settings::default()),
+            Outcome::Snapshot(settings) => Ok(settings),
+            _ => Ok(Snapshot::default()),
         }
     }
 
     /// Writes a snapshot back (never starts a calibration).
-    pub async fn restore_settings(&mut self, settings: &Settings) -> Result<(), Error<U::Error>> {
+    pub async fn restore_settings(&mut self, settings: &Snapshot) -> Result<(), Error<U::Error>> {
         self.run(Request::RestoreSettings(*settings))
             .await
             .map(|_| ())

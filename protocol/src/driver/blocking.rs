@@ -26,7 +26,7 @@ use super::{
     Clock, Config, CoreError, DriverCore, Error, Event, Outcome, Readable, Request, RxBuffer,
 };
 use crate::command::{Action, Motors, Register, Turn, Velocity, Write};
-use crate::registers::Settings;
+use crate::registers::Snapshot;
 use embedded_io::{Read, ReadReady, Write as IoWrite};
 
 /// Polls in a row that see the clock stand still and no byte come before a wait gives up with
@@ -172,16 +172,16 @@ where
         self.send(&bytes)
     }
 
-    /// Reads every register of a [`Settings`] snapshot, each read verified.
-    pub fn read_settings(&mut self) -> Result<Settings, Error<U::Error>> {
+    /// Reads every register of a [`Snapshot`] snapshot, each read verified.
+    pub fn read_settings(&mut self) -> Result<Snapshot, Error<U::Error>> {
         match self.run(Request::ReadSettings)? {
-            Outcome::Settings(settings) => Ok(settings),
-            _ => Ok(Settings::default()),
+            Outcome::Snapshot(settings) => Ok(settings),
+            _ => Ok(Snapshot::default()),
         }
     }
 
     /// Writes a snapshot back ([`Request::RestoreSettings`]: never starts a calibration).
-    pub fn restore_settings(&mut self, settings: &Settings) -> Result<(), Error<U::Error>> {
+    pub fn restore_settings(&mut self, settings: &Snapshot) -> Result<(), Error<U::Error>> {
         self.run(Request::RestoreSettings(*settings)).map(|_| ())
     }
 

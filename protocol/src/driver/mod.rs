@@ -96,7 +96,7 @@ pub mod nb;
 mod sans_io;
 mod split;
 
-pub use crate::registers::{BatteryRange, Readable, Settings, reg};
+pub use crate::registers::{BatteryRange, Readable, Snapshot, reg};
 pub use sans_io::{DriverCore, Event, Outcome, Outgoing, Request, RxBuffer, Stamped, StreamInfo};
 pub use split::Split;
 

@@ -28,8 +28,8 @@ use super::{Config, CoreError};
 use crate::bytes::FrameBytes;
 use crate::command::{Action, Motors, Register, Setting, Turn, Velocity, Write};
 use crate::parse::{DownlinkParser, DownlinkStats, Lock};
-use crate::registers::{self, Settings};
-use crate::telemetry::{Battery, Encoders, Imu, Reply, Stream, Telemetry};
+use crate::registers::{self, Snapshot};
+use crate::telemetry::{Battery, Downlink, Encoders, Imu, Reply, Stream};
 
 /// The bytes of one command frame (10 or 12 bytes).
 pub type Outgoing = FrameBytes<12>;
@@ -51,11 +51,11 @@ pub struct Stamped<T> {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct StreamInfo {
-    /// Frames received.
+    /// DownlinkFrames received.
     pub frames: u32,
-    /// Frames missing according to the count bytes.
+    /// DownlinkFrames missing according to the count bytes.
     pub missed: u32,
-    /// Frames per second over the last window of at least [`StreamInfo::WINDOW_MS`], in
+    /// DownlinkFrames per second over the last window of at least [`StreamInfo::WINDOW_MS`], in
     /// thousandths (0 until a window has closed).
     pub rate_millihertz: u32,
     window_start_ms: Option<u64>,
@@ -67,7 +67,7 @@ impl StreamInfo {
     /// slow loop, a USB-UART) still give the stream's real rate.
     pub const WINDOW_MS: u64 = 1_000;
 
-    /// Frames per second (rounded down; 0 until a window has closed).
+    /// DownlinkFrames per second (rounded down; 0 until a window has closed).
     #[must_use]
     pub const fn rate_hz(&self) -> u32 {
         self.rate_millihertz / 1_000
@@ -99,7 +99,7 @@ impl StreamInfo {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Event {
     /// A telemetry frame (also kept as the latest of its stream).
-    Telemetry(Telemetry),
+    Telemetry(Downlink),
     /// A reply that the request in progress was waiting for.
     Reply(Reply),
     /// A reply nobody waits for (a late one, or a damaged one).
@@ -119,13 +119,13 @@ pub enum Request {
     /// There is no checksum: a changed byte changes a reply unseen, and this is how a value
     /// that matters is read. [`Outcome::Value`], or [`CoreError::Unconfirmed`].
     ReadVerified(Register),
-    /// Every register of a [`Settings`] snapshot, each read verified: [`Outcome::Settings`].
+    /// Every register of a [`Snapshot`] snapshot, each read verified: [`Outcome::Snapshot`].
     ReadSettings,
-    /// Writes a snapshot back (all but the calibration value: [`Settings::writes`]). The
+    /// Writes a snapshot back (all but the calibration value: [`Snapshot::writes`]). The
     /// system mode's gyro-compensation bit (3) is left as the board has it (read first):
     /// switching it on starts a 30 s calibration, which a restore must never do by surprise.
     /// [`Outcome::Done`].
-    RestoreSettings(Settings),
+    RestoreSettings(Snapshot),
     /// Cancels a turn in progress: reads the angle still pending and sends the opposite turn,
     /// then releases the turn guard. [`Outcome::Done`].
     CancelTurn,
@@ -138,7 +138,7 @@ pub enum Outcome {
     /// A register's raw value (see [`crate::registers::Readable`] for its type).
     Value(u32),
     /// A whole snapshot.
-    Settings(Settings),
+    Snapshot(Snapshot),
     /// Done: nothing to return.
     Done,
 }
@@ -262,8 +262,8 @@ struct Job {
     step: Step,
     /// Which step of the request's sequence this is.
     index: u8,
-    /// Settings read so far (ReadSettings).
-    settings: Settings,
+    /// Snapshot read so far (ReadSettings).
+    settings: Snapshot,
 }
 
 /// The driver's logic: frames out, telemetry in, requests and their replies, timeouts and
@@ -666,7 +666,7 @@ impl DriverCore {
         let step = match request {
             Request::Read(register) => Step::Read(Read::new(register, Check::Once)),
             Request::ReadVerified(register) => Step::Read(Read::new(register, Check::Agree)),
-            Request::ReadSettings => match Settings::REGISTERS.first() {
+            Request::ReadSettings => match Snapshot::REGISTERS.first() {
                 Some(register) => Step::Read(Read::new(*register, Check::Agree)),
                 None => Step::Read(Read::new(Register::MaxSpeed, Check::Agree)),
             },
@@ -679,7 +679,7 @@ impl DriverCore {
             request,
             step,
             index: 0,
-            settings: Settings::default(),
+            settings: Snapshot::default(),
         });
     }
 
@@ -712,9 +712,9 @@ impl DriverCore {
                         job.settings.set(write);
                     }
                 }
-                match Settings::REGISTERS.get(usize::from(job.index)) {
+                match Snapshot::REGISTERS.get(usize::from(job.index)) {
                     Some(register) => Step::Read(Read::new(*register, Check::Agree)),
-                    None => return self.finish(Ok(Outcome::Settings(job.settings))),
+                    None => return self.finish(Ok(Outcome::Snapshot(job.settings))),
                 }
             }
             (Request::RestoreSettings(mut settings), value) => {
@@ -836,31 +836,31 @@ impl DriverCore {
         }
     }
 
-    fn frame(&mut self, frame: Telemetry, now_ms: u64) -> Event {
+    fn frame(&mut self, frame: Downlink, now_ms: u64) -> Event {
         self.last_heard_ms = Some(now_ms);
         let stream = match frame {
-            Telemetry::Imu(value) => {
+            Downlink::Imu(value) => {
                 self.imu = Some(Stamped {
                     value,
                     at_ms: now_ms,
                 });
                 Stream::Imu
             }
-            Telemetry::Encoders(value) => {
+            Downlink::Encoders(value) => {
                 self.encoders = Some(Stamped {
                     value,
                     at_ms: now_ms,
                 });
                 Stream::Encoders
             }
-            Telemetry::Battery(value) => {
+            Downlink::Battery(value) => {
                 self.battery = Some(Stamped {
                     value,
                     at_ms: now_ms,
                 });
                 Stream::Battery
             }
-            Telemetry::Reply(reply) => return self.reply(reply),
+            Downlink::Reply(reply) => return self.reply(reply),
         };
         self.last_telemetry_ms = Some(now_ms);
         let missed = self.parser.stats().missed_of(stream);

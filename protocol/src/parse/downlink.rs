@@ -118,7 +118,7 @@
 
 use super::stats::DownlinkStats;
 use super::window::Window;
-use crate::telemetry::{self, Kind, Stream, Telemetry};
+use crate::telemetry::{self, Downlink, Kind, Stream};
 
 /// Bytes kept: the longest frame and the two bytes after it.
 const WINDOW: usize = telemetry::MAX_LEN + 2;
@@ -202,7 +202,7 @@ struct State {
     weak: bool,
     /// While Tentative: frames so far whose count continued their stream.
     confirms: u8,
-    /// Telemetry frames accepted since the last one that continued its count (saturating).
+    /// Downlink frames accepted since the last one that continued its count (saturating).
     since_continued: u8,
     /// The last `poll` emitted a frame: another may be ready without a new byte.
     drain: bool,
@@ -236,7 +236,7 @@ enum Verdict {
     /// that a header followed, turned down only for its count: remembered as a jump.
     Reject(Option<(Stream, u8)>),
     /// A frame of this length.
-    Accept(Telemetry, usize),
+    Accept(Downlink, usize),
 }
 
 /// How a candidate's count relates to its stream's last count.
@@ -265,7 +265,7 @@ enum Continuity {
 /// The board → master streaming parser. See the [module docs](self) for how it resynchronises.
 ///
 /// ```
-/// use chassis_protocol::{Battery, DownlinkParser, Lock, Telemetry};
+/// use chassis_protocol::{Battery, DownlinkParser, Lock, Downlink};
 ///
 /// let battery = Battery { centivolts: 1_100, percent: 87, seq: 3 };
 /// let mut parser = DownlinkParser::new();
@@ -278,9 +278,9 @@ enum Continuity {
 ///     got.extend(parser.frames(read));
 /// }
 /// assert_eq!(got.len(), 1);
-/// assert!(matches!(got[0], Telemetry::Imu(imu) if imu.gyro == [0, -4, 2] && imu.seq == 7));
+/// assert!(matches!(got[0], Downlink::Imu(imu) if imu.gyro == [0, -4, 2] && imu.seq == 7));
 /// // The line goes quiet: that ends the battery frame as a header would.
-/// assert_eq!(parser.idle(), Some(Telemetry::Battery(battery)));
+/// assert_eq!(parser.idle(), Some(Downlink::Battery(battery)));
 /// assert_eq!(parser.lock(), Lock::Tentative);
 /// assert_eq!(parser.stats().discarded, 0);
 /// ```
@@ -331,7 +331,7 @@ impl DownlinkParser {
     /// [`push_slice`]: DownlinkParser::push_slice
     /// [`poll`]: DownlinkParser::poll
     /// [`idle`]: DownlinkParser::idle
-    pub fn push(&mut self, byte: u8) -> Option<Telemetry> {
+    pub fn push(&mut self, byte: u8) -> Option<Downlink> {
         let ready = if self.state.drain { self.poll() } else { None };
         self.append(&[byte]);
         match ready {
@@ -346,7 +346,7 @@ impl DownlinkParser {
     /// same states as feeding the same bytes one at a time through
     /// [`push`](DownlinkParser::push), so it emits the same frames in the same order; it only
     /// copies a frame's body in one step where no decision can fall in between.
-    pub fn push_slice<'a>(&mut self, mut bytes: &'a [u8]) -> (Option<Telemetry>, &'a [u8]) {
+    pub fn push_slice<'a>(&mut self, mut bytes: &'a [u8]) -> (Option<Downlink>, &'a [u8]) {
         if bytes.is_empty() && self.state.drain {
             return (self.poll(), bytes);
         }
@@ -371,15 +371,15 @@ impl DownlinkParser {
     }
 
     /// An iterator over the frames in `bytes`; every byte is consumed by the time it ends.
-    pub fn frames<'p, 'b>(&'p mut self, bytes: &'b [u8]) -> Frames<'p, 'b> {
-        Frames {
+    pub fn frames<'p, 'b>(&'p mut self, bytes: &'b [u8]) -> DownlinkFrames<'p, 'b> {
+        DownlinkFrames {
             parser: self,
             rest: bytes,
         }
     }
 
     /// Emits a frame that is already complete in the window, if any, without a new byte.
-    pub fn poll(&mut self) -> Option<Telemetry> {
+    pub fn poll(&mut self) -> Option<Downlink> {
         loop {
             match self.judge(false) {
                 Verdict::NeedMore => {
@@ -406,7 +406,7 @@ impl DownlinkParser {
     /// empty, the next byte is taken to start a frame (the parser becomes at least
     /// *Tentative*). UART peripherals
     /// with an idle-line interrupt make this free; without one, call it from a timeout.
-    pub fn idle(&mut self) -> Option<Telemetry> {
+    pub fn idle(&mut self) -> Option<Downlink> {
         loop {
             match self.judge(true) {
                 Verdict::NeedMore => {
@@ -497,12 +497,12 @@ impl DownlinkParser {
     }
 
     /// How `frame`'s count relates to its stream's last one.
-    fn continuity(&self, frame: &Telemetry) -> Continuity {
+    fn continuity(&self, frame: &Downlink) -> Continuity {
         self.continuity_given(frame, self.state.provisional)
     }
 
     /// [`continuity`](Self::continuity), with `provisional` as the set of provisional counts.
-    fn continuity_given(&self, frame: &Telemetry, provisional: u8) -> Continuity {
+    fn continuity_given(&self, frame: &Downlink, provisional: u8) -> Continuity {
         let state = &self.state;
         let (Some(seq), Kind::Telemetry(stream)) = (frame.seq(), frame.kind()) else {
             return Continuity::Reply;
@@ -523,7 +523,7 @@ impl DownlinkParser {
         if provisional & bit != 0 {
             return Continuity::Provisional;
         }
-        // Frames may have been lost in the bytes before this candidate.
+        // DownlinkFrames may have been lost in the bytes before this candidate.
         let before = usize::from(state.since_confirmed).saturating_sub(state.window.len());
         let i = stream.index();
         let per_frame = BYTES_PER_FRAME.get(i).copied().unwrap_or(u16::MAX).max(1);
@@ -545,7 +545,7 @@ impl DownlinkParser {
 
     /// While hunting, a provisional count still says where the stream was: whether `frame`'s
     /// count is near it, as if it were trusted.
-    fn provisional_near(&self, frame: &Telemetry) -> bool {
+    fn provisional_near(&self, frame: &Downlink) -> bool {
         matches!(
             self.continuity_given(frame, 0),
             Continuity::Continues | Continuity::Near
@@ -574,7 +574,7 @@ impl DownlinkParser {
                 Verdict::NeedMore
             };
         };
-        let Ok(frame) = Telemetry::decode(bytes) else {
+        let Ok(frame) = Downlink::decode(bytes) else {
             return Verdict::Reject(None);
         };
         let continuity = self.continuity(&frame);
@@ -685,7 +685,7 @@ impl DownlinkParser {
     }
 
     /// Consumes an accepted frame: counts, count history, lock.
-    fn accept(&mut self, frame: &Telemetry, len: usize) {
+    fn accept(&mut self, frame: &Downlink, len: usize) {
         let continuity = self.continuity(frame);
         let state = &mut self.state;
         state.window.drop_front(len);
@@ -794,15 +794,15 @@ fn record_seq(
 /// Iterator over the frames of a byte slice: see [`DownlinkParser::frames`].
 #[derive(Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Frames<'p, 'b> {
+pub struct DownlinkFrames<'p, 'b> {
     parser: &'p mut DownlinkParser,
     rest: &'b [u8],
 }
 
-impl Iterator for Frames<'_, '_> {
-    type Item = Telemetry;
+impl Iterator for DownlinkFrames<'_, '_> {
+    type Item = Downlink;
 
-    fn next(&mut self) -> Option<Telemetry> {
+    fn next(&mut self) -> Option<Downlink> {
         let (frame, rest) = self.parser.push_slice(self.rest);
         self.rest = rest;
         frame
@@ -822,7 +822,7 @@ mod tests {
         }
     }
 
-    fn feed(parser: &mut DownlinkParser, bytes: &[u8]) -> Vec<Telemetry> {
+    fn feed(parser: &mut DownlinkParser, bytes: &[u8]) -> Vec<Downlink> {
         bytes.iter().filter_map(|b| parser.push(*b)).collect()
     }
 
@@ -841,14 +841,14 @@ mod tests {
         let c = imu(3, 0).encode();
         // The first frame proves itself by the following header.
         assert_eq!(feed(&mut p, &a), vec![]);
-        assert_eq!(feed(&mut p, &b[..2]), vec![Telemetry::Imu(imu(1, 0))]);
+        assert_eq!(feed(&mut p, &b[..2]), vec![Downlink::Imu(imu(1, 0))]);
         assert_eq!(p.lock(), Lock::Tentative);
         // The second continues the count: out on its last byte, and the lock is confirmed.
         assert_eq!(feed(&mut p, &b[2..14]), vec![]);
-        assert_eq!(p.push(b[14]), Some(Telemetry::Imu(imu(2, 0))));
+        assert_eq!(p.push(b[14]), Some(Downlink::Imu(imu(2, 0))));
         assert_eq!(p.lock(), Lock::Tentative);
         assert_eq!(feed(&mut p, &c[..14]), vec![]);
-        assert_eq!(p.push(c[14]), Some(Telemetry::Imu(imu(3, 0))));
+        assert_eq!(p.push(c[14]), Some(Downlink::Imu(imu(3, 0))));
         // Two frames in a row have continued their counts: the lock is confirmed.
         assert_eq!(p.lock(), Lock::Locked);
         assert_eq!(p.buffered(), 0);
@@ -863,7 +863,7 @@ mod tests {
         }
         let reply = Reply::new(Register::MaxSpeed, 500);
         let out = feed(&mut p, &reply.encode());
-        assert_eq!(out, vec![Telemetry::Reply(reply)]);
+        assert_eq!(out, vec![Downlink::Reply(reply)]);
         assert_eq!(p.lock(), Lock::Locked);
     }
 
@@ -908,7 +908,7 @@ mod tests {
         let imu_counts: Vec<u8> = out
             .iter()
             .filter(|f| f.kind() == Kind::Telemetry(Stream::Imu))
-            .filter_map(Telemetry::seq)
+            .filter_map(Downlink::seq)
             .collect();
         let expected: Vec<u8> = (1..=8u8).chain(21..=40).collect();
         assert_eq!(imu_counts, expected);
@@ -927,7 +927,7 @@ mod tests {
         stream.insert(2 * 15 + 7, 0xFF);
         let mut out: Vec<u8> = feed(&mut p, &stream)
             .iter()
-            .filter_map(Telemetry::seq)
+            .filter_map(Downlink::seq)
             .collect();
         out.extend(core::iter::from_fn(|| p.idle()).filter_map(|f| f.seq()));
         assert_eq!(out, vec![10, 11, 13, 14, 15]);
@@ -951,11 +951,11 @@ mod tests {
         stream.extend_from_slice(&imu(42, 0).encode());
         let out = feed(&mut p, &stream);
         assert_eq!(
-            out.first().map(Telemetry::kind),
+            out.first().map(Downlink::kind),
             Some(Kind::Telemetry(Stream::Encoders))
         );
         assert_eq!(
-            out.iter().filter_map(Telemetry::seq).collect::<Vec<_>>(),
+            out.iter().filter_map(Downlink::seq).collect::<Vec<_>>(),
             vec![9, 41, 42]
         );
     }
@@ -975,7 +975,7 @@ mod tests {
         assert_eq!(p.stats().discarded, 7);
         // After a quiet line it starts a frame: complete at the next quiet line, so taken.
         assert_eq!(feed(&mut p, &b.encode()), vec![]);
-        assert_eq!(p.idle(), Some(Telemetry::Battery(b)));
+        assert_eq!(p.idle(), Some(Downlink::Battery(b)));
         assert_eq!(p.idle(), None);
         assert_eq!(feed(&mut p, &[0x23, 0x01, 0x00]), vec![]);
         assert_eq!(p.idle(), None);
@@ -984,7 +984,7 @@ mod tests {
         // After a quiet line the next byte is taken to start a frame: a reply comes out at once.
         assert_eq!(p.lock(), Lock::Tentative);
         let reply = Reply::new(Register::PendingAngle, 0);
-        assert_eq!(feed(&mut p, &reply.encode()), vec![Telemetry::Reply(reply)]);
+        assert_eq!(feed(&mut p, &reply.encode()), vec![Downlink::Reply(reply)]);
     }
 
     #[test]
@@ -999,7 +999,7 @@ mod tests {
         stream.extend_from_slice(&imu(201, 0).encode());
         let out = feed(&mut p, &stream);
         assert_eq!(
-            out.iter().filter_map(Telemetry::seq).collect::<Vec<_>>(),
+            out.iter().filter_map(Downlink::seq).collect::<Vec<_>>(),
             vec![200, 201]
         );
     }
@@ -1018,7 +1018,7 @@ mod tests {
             }
             let out = feed(&mut p, &stream);
             assert!(
-                out.iter().filter_map(Telemetry::seq).any(|s| s == 1),
+                out.iter().filter_map(Downlink::seq).any(|s| s == 1),
                 "stuck after {value:#04x}"
             );
         }

@@ -2,7 +2,7 @@
 //!
 //! | parser | direction | emits | state |
 //! |---|---|---|---|
-//! | [`DownlinkParser`] | board → master | [`Telemetry`](crate::Telemetry) | 32 bytes |
+//! | [`DownlinkParser`] | board → master | [`Downlink`](crate::Downlink) | 32 bytes |
 //! | [`UplinkParser`] | master → board | [`Command`](crate::Command) | 13 bytes |
 //!
 //! Both are `const fn new()`, take bytes one at a time ([`push`](DownlinkParser::push)) or a
@@ -15,6 +15,6 @@ pub mod stats;
 pub mod uplink;
 mod window;
 
-pub use downlink::{DownlinkParser, Frames, Lock};
+pub use downlink::{DownlinkFrames, DownlinkParser, Lock};
 pub use stats::{DownlinkStats, UplinkStats};
 pub use uplink::{UplinkFrames, UplinkParser};

@@ -4,7 +4,7 @@
 //!
 //! ```
 //! use chassis_protocol::sim::{Board, SimConfig};
-//! use chassis_protocol::{DownlinkParser, Register, Setting, Telemetry};
+//! use chassis_protocol::{DownlinkParser, Register, Setting, Downlink};
 //!
 //! let mut board = Board::new(SimConfig::default());
 //! board.receive(&Setting::Read(Register::MotorVoltage).encode());
@@ -14,13 +14,13 @@
 //! for ms in 0..100 {
 //!     board.advance(ms);
 //!     let n = board.transmit(&mut buf);
-//!     let mut frames: Vec<Telemetry> = parser.frames(&buf[..n]).collect();
+//!     let mut frames: Vec<Downlink> = parser.frames(&buf[..n]).collect();
 //!     if n == 0 {
 //!         // A quiet millisecond: the telemetry is paused while settings are made.
 //!         frames.extend(core::iter::from_fn(|| parser.idle()));
 //!     }
 //!     for frame in frames {
-//!         if let Telemetry::Reply(r) = frame { reply = Some(r); }
+//!         if let Downlink::Reply(r) = frame { reply = Some(r); }
 //!     }
 //! }
 //! assert_eq!(reply.map(|r| r.value), Some(1_200)); // 12.00 V, the factory default
@@ -47,18 +47,18 @@
 //! * **Angle mode accumulates**, exactly as the spec warns: every frame with the angle bit adds
 //!   its angle to the pending turn; the chassis turns at 90°/s until the pending angle is 0.
 //!   [`Board::total_turn_commanded`] tells a test what was asked in all.
-//! * **Telemetry pauses while settings are made** (A6): every settings frame stops it, and it
+//! * **Downlink pauses while settings are made** (A6): every settings frame stops it, and it
 //!   resumes [`SimConfig::resume_after_ms`] (100 ms by default: a parameter, since the vendor
 //!   does not say, A13) after the last one. Counts carry on from
 //!   where they stopped (they count frames sent).
 //! * Replies go out [`SimConfig::reply_delay_ms`] after the read arrives.
-//! * Telemetry: IMU at 100 Hz, encoders at 25 Hz, battery at 1 Hz, each with its rolling count;
+//! * Downlink: IMU at 100 Hz, encoders at 25 Hz, battery at 1 Hz, each with its rolling count;
 //!   simple kinematics for omni, mecanum and differential chassis move the encoders and gyro Z;
 //!   the battery drains.
 
 use crate::command::Command;
 use crate::parse::UplinkParser;
-use crate::registers::Settings;
+use crate::registers::Snapshot;
 use crate::telemetry::Reply;
 use heapless::Deque;
 
@@ -89,7 +89,7 @@ pub struct SimConfig {
     pub seed: u64,
     /// Delay between a read arriving and its reply going out, in ms.
     pub reply_delay_ms: u32,
-    /// Telemetry resumes this long after the last settings frame, in ms.
+    /// Downlink resumes this long after the last settings frame, in ms.
     pub resume_after_ms: u32,
 }
 
@@ -110,8 +110,8 @@ pub struct Board {
     faults: Faults,
     uplink: UplinkParser,
     now_ms: u64,
-    live: Settings,
-    stored: Settings,
+    live: Snapshot,
+    stored: Snapshot,
     motion: Motion,
     pending_deci_degrees: i64,
     total_turn_deci_degrees: i64,
@@ -220,13 +220,13 @@ impl Board {
 
     /// The live registers.
     #[must_use]
-    pub const fn registers(&self) -> &Settings {
+    pub const fn registers(&self) -> &Snapshot {
         &self.live
     }
 
     /// The stored registers.
     #[must_use]
-    pub const fn stored_registers(&self) -> &Settings {
+    pub const fn stored_registers(&self) -> &Snapshot {
         &self.stored
     }
 
@@ -266,7 +266,7 @@ impl Board {
         self.commands
     }
 
-    /// Telemetry frames dropped because the output buffer was full.
+    /// Downlink frames dropped because the output buffer was full.
     #[must_use]
     pub const fn dropped_frames(&self) -> u32 {
         self.dropped_frames

@@ -3,11 +3,11 @@
 
 use super::Board;
 use crate::command::{Action, DriveType, Register, Setting, SystemMode, Write};
-use crate::registers::Settings;
+use crate::registers::Snapshot;
 use crate::telemetry::Reply;
 
 /// The factory defaults of the model (the vendor does not publish them; these are chosen).
-pub const FACTORY: Settings = Settings {
+pub const FACTORY: Snapshot = Snapshot {
     max_speed: 1_000,
     speed_kp: 300,
     speed_ki: 20,

@@ -2,9 +2,9 @@
 //! rolling count.
 
 use super::{Board, Motion, clamp_i32};
-use crate::telemetry::{Battery, Encoders, Imu, Telemetry};
+use crate::telemetry::{Battery, Downlink, Encoders, Imu};
 
-/// Telemetry periods in ms: IMU, encoders, battery.
+/// Downlink periods in ms: IMU, encoders, battery.
 const PERIODS_MS: [u64; 3] = [10, 40, 1_000];
 
 impl Board {
@@ -32,7 +32,7 @@ impl Board {
         }
     }
 
-    pub(super) fn telemetry(&mut self, stream: usize) -> Telemetry {
+    pub(super) fn telemetry(&mut self, stream: usize) -> Downlink {
         let seq = match self.seq.get_mut(stream) {
             Some(s) => {
                 *s = s.wrapping_add(1);
@@ -49,7 +49,7 @@ impl Board {
                 };
                 let turning = clamp_i32(self.turn_carry.saturating_mul(10));
                 let gyro_z = rotation.saturating_add(turning).clamp(-32_768, 32_767) as i16;
-                Telemetry::Imu(Imu {
+                Downlink::Imu(Imu {
                     accel: [
                         noise(self),
                         noise(self),
@@ -59,7 +59,7 @@ impl Board {
                     seq,
                 })
             }
-            1 => Telemetry::Encoders(Encoders {
+            1 => Downlink::Encoders(Encoders {
                 ticks: self.wheel_ticks,
                 seq,
             }),
@@ -78,7 +78,7 @@ impl Board {
                     .checked_div(span)
                     .unwrap_or(0)
                     .min(100) as u16;
-                Telemetry::Battery(Battery {
+                Downlink::Battery(Battery {
                     centivolts: self.centivolts,
                     percent,
                     seq,

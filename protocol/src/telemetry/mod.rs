@@ -26,8 +26,8 @@ use crate::error::Error;
 /// The longest board → master frame ([`Imu`]).
 pub const MAX_LEN: usize = Imu::LEN;
 
-/// The encoded bytes of a [`Telemetry`] frame.
-pub type TelemetryBytes = FrameBytes<MAX_LEN>;
+/// The encoded bytes of a [`Downlink`] frame.
+pub type DownlinkBytes = FrameBytes<MAX_LEN>;
 
 /// Checks the length and two-byte header of a telemetry frame.
 fn check_frame(bytes: &[u8], header: &[u8; 2], len: usize) -> Result<(), Error> {
@@ -128,11 +128,12 @@ impl Kind {
     }
 }
 
-/// Any board → master frame.
+/// Any board → master frame: one of the three telemetry streams, or a reply. Named for the
+/// direction: a reply is not telemetry.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub enum Telemetry {
+pub enum Downlink {
     /// `FF FA`.
     Imu(Imu),
     /// `FF FB`.
@@ -143,15 +144,15 @@ pub enum Telemetry {
     Reply(Reply),
 }
 
-impl Telemetry {
+impl Downlink {
     /// The frame's kind.
     #[must_use]
     pub const fn kind(&self) -> Kind {
         match self {
-            Telemetry::Imu(_) => Kind::Telemetry(Stream::Imu),
-            Telemetry::Encoders(_) => Kind::Telemetry(Stream::Encoders),
-            Telemetry::Battery(_) => Kind::Telemetry(Stream::Battery),
-            Telemetry::Reply(_) => Kind::Reply,
+            Downlink::Imu(_) => Kind::Telemetry(Stream::Imu),
+            Downlink::Encoders(_) => Kind::Telemetry(Stream::Encoders),
+            Downlink::Battery(_) => Kind::Telemetry(Stream::Battery),
+            Downlink::Reply(_) => Kind::Reply,
         }
     }
 
@@ -159,21 +160,21 @@ impl Telemetry {
     #[must_use]
     pub const fn seq(&self) -> Option<u8> {
         match self {
-            Telemetry::Imu(f) => Some(f.seq),
-            Telemetry::Encoders(f) => Some(f.seq),
-            Telemetry::Battery(f) => Some(f.seq),
-            Telemetry::Reply(_) => None,
+            Downlink::Imu(f) => Some(f.seq),
+            Downlink::Encoders(f) => Some(f.seq),
+            Downlink::Battery(f) => Some(f.seq),
+            Downlink::Reply(_) => None,
         }
     }
 
     /// The frame's bytes.
     #[must_use]
-    pub fn encode(&self) -> TelemetryBytes {
+    pub fn encode(&self) -> DownlinkBytes {
         match self {
-            Telemetry::Imu(f) => TelemetryBytes::new(&f.encode()),
-            Telemetry::Encoders(f) => TelemetryBytes::new(&f.encode()),
-            Telemetry::Battery(f) => TelemetryBytes::new(&f.encode()),
-            Telemetry::Reply(f) => TelemetryBytes::new(&f.encode()),
+            Downlink::Imu(f) => DownlinkBytes::new(&f.encode()),
+            Downlink::Encoders(f) => DownlinkBytes::new(&f.encode()),
+            Downlink::Battery(f) => DownlinkBytes::new(&f.encode()),
+            Downlink::Reply(f) => DownlinkBytes::new(&f.encode()),
         }
     }
 
@@ -181,37 +182,37 @@ impl Telemetry {
     /// unknown code decodes (it is kept, not rejected).
     pub fn decode(bytes: &[u8]) -> Result<Self, Error> {
         match bytes {
-            [0xFF, 0xFA, ..] => Imu::decode(bytes).map(Telemetry::Imu),
-            [0xFF, 0xFB, ..] => Encoders::decode(bytes).map(Telemetry::Encoders),
-            [0xFF, 0xFC, ..] => Battery::decode(bytes).map(Telemetry::Battery),
-            [Reply::HEADER, ..] => Reply::decode(bytes).map(Telemetry::Reply),
+            [0xFF, 0xFA, ..] => Imu::decode(bytes).map(Downlink::Imu),
+            [0xFF, 0xFB, ..] => Encoders::decode(bytes).map(Downlink::Encoders),
+            [0xFF, 0xFC, ..] => Battery::decode(bytes).map(Downlink::Battery),
+            [Reply::HEADER, ..] => Reply::decode(bytes).map(Downlink::Reply),
             [] | [0xFF] => Err(Error::Length),
             _ => Err(Error::Header),
         }
     }
 }
 
-impl From<Imu> for Telemetry {
+impl From<Imu> for Downlink {
     fn from(f: Imu) -> Self {
-        Telemetry::Imu(f)
+        Downlink::Imu(f)
     }
 }
 
-impl From<Encoders> for Telemetry {
+impl From<Encoders> for Downlink {
     fn from(f: Encoders) -> Self {
-        Telemetry::Encoders(f)
+        Downlink::Encoders(f)
     }
 }
 
-impl From<Battery> for Telemetry {
+impl From<Battery> for Downlink {
     fn from(f: Battery) -> Self {
-        Telemetry::Battery(f)
+        Downlink::Battery(f)
     }
 }
 
-impl From<Reply> for Telemetry {
+impl From<Reply> for Downlink {
     fn from(f: Reply) -> Self {
-        Telemetry::Reply(f)
+        Downlink::Reply(f)
     }
 }
 
@@ -246,17 +247,17 @@ mod tests {
     #[test]
     fn decode_any() {
         let battery = [0xFF, 0xFC, 0x04, 0x4C, 0x00, 0x57, 0x03];
-        let frame = Telemetry::decode(&battery).unwrap();
+        let frame = Downlink::decode(&battery).unwrap();
         assert_eq!(frame.kind(), Kind::Telemetry(Stream::Battery));
         assert_eq!(frame.seq(), Some(3));
         assert_eq!(frame.encode().as_slice(), &battery);
-        assert_eq!(Telemetry::decode(&[0xFF]), Err(Error::Length));
+        assert_eq!(Downlink::decode(&[0xFF]), Err(Error::Length));
         assert_eq!(
-            Telemetry::decode(&[0xFF, 0xFE, 0, 0, 0, 0, 0]),
+            Downlink::decode(&[0xFF, 0xFE, 0, 0, 0, 0, 0]),
             Err(Error::Header)
         );
         assert_eq!(
-            Telemetry::decode(&[0x23, 0x99, 0, 0, 0, 0]).map(|f| f.seq()),
+            Downlink::decode(&[0x23, 0x99, 0, 0, 0, 0]).map(|f| f.seq()),
             Ok(None)
         );
     }
