@@ -15,9 +15,9 @@ use std::collections::HashMap;
 /// The figures of one run.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Score {
-    /// DownlinkFrames sent.
+    /// Frames sent.
     pub sent: usize,
-    /// DownlinkFrames the channel left untouched.
+    /// Frames the channel left untouched.
     pub untouched: usize,
     /// Untouched frames emitted equal at their place.
     pub recalled: usize,

@@ -1,4 +1,4 @@
-//! DownlinkFrames and streaming parsers for the chassis motor-controller board's UART protocol.
+//! Frames and streaming parsers for the chassis motor-controller board's UART protocol.
 //!
 //! `no_std`, no allocation, no `unsafe`, no panic on any input. The same crate runs on the
 //! microcontroller that drives the chassis, on a Linux host behind a USB-UART adapter, in the

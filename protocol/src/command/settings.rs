@@ -1,4 +1,4 @@
-//! Snapshot, master → board: mode `0x80`, always 10 bytes (spec 2A–2D).
+//! Settings, master → board: mode `0x80`, always 10 bytes (spec 2A–2D).
 //!
 //! | byte | 0 | 1 | 2 | 3 | 4 | 5–8 | 9 |
 //! |---|---|---|---|---|---|---|---|

@@ -175,7 +175,7 @@ where
         self.send(&bytes).await
     }
 
-    /// Reads every register of a [`Snapshot`] snapshot, each read verified.
+    /// Reads every register of a [`Snapshot`], each read verified.
     pub async fn read_settings(&mut self) -> Result<Snapshot, Error<U::Error>> {
         match self.run(Request::ReadSettings).await? {
             Outcome::Snapshot(settings) => Ok(settings),

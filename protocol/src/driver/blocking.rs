@@ -172,7 +172,7 @@ where
         self.send(&bytes)
     }
 
-    /// Reads every register of a [`Snapshot`] snapshot, each read verified.
+    /// Reads every register of a [`Snapshot`], each read verified.
     pub fn read_settings(&mut self) -> Result<Snapshot, Error<U::Error>> {
         match self.run(Request::ReadSettings)? {
             Outcome::Snapshot(settings) => Ok(settings),

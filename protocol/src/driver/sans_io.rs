@@ -51,11 +51,11 @@ pub struct Stamped<T> {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct StreamInfo {
-    /// DownlinkFrames received.
+    /// Frames received.
     pub frames: u32,
-    /// DownlinkFrames missing according to the count bytes.
+    /// Frames missing according to the count bytes.
     pub missed: u32,
-    /// DownlinkFrames per second over the last window of at least [`StreamInfo::WINDOW_MS`], in
+    /// Frames per second over the last window of at least [`StreamInfo::WINDOW_MS`], in
     /// thousandths (0 until a window has closed).
     pub rate_millihertz: u32,
     window_start_ms: Option<u64>,
@@ -67,7 +67,7 @@ impl StreamInfo {
     /// slow loop, a USB-UART) still give the stream's real rate.
     pub const WINDOW_MS: u64 = 1_000;
 
-    /// DownlinkFrames per second (rounded down; 0 until a window has closed).
+    /// Frames per second (rounded down; 0 until a window has closed).
     #[must_use]
     pub const fn rate_hz(&self) -> u32 {
         self.rate_millihertz / 1_000
@@ -119,7 +119,7 @@ pub enum Request {
     /// There is no checksum: a changed byte changes a reply unseen, and this is how a value
     /// that matters is read. [`Outcome::Value`], or [`CoreError::Unconfirmed`].
     ReadVerified(Register),
-    /// Every register of a [`Snapshot`] snapshot, each read verified: [`Outcome::Snapshot`].
+    /// Every register of a [`Snapshot`], each read verified: [`Outcome::Snapshot`].
     ReadSettings,
     /// Writes a snapshot back (all but the calibration value: [`Snapshot::writes`]). The
     /// system mode's gyro-compensation bit (3) is left as the board has it (read first):
@@ -262,7 +262,7 @@ struct Job {
     step: Step,
     /// Which step of the request's sequence this is.
     index: u8,
-    /// Snapshot read so far (ReadSettings).
+    /// Registers read so far (ReadSettings).
     settings: Snapshot,
 }
 

@@ -523,7 +523,7 @@ impl DownlinkParser {
         if provisional & bit != 0 {
             return Continuity::Provisional;
         }
-        // DownlinkFrames may have been lost in the bytes before this candidate.
+        // Frames may have been lost in the bytes before this candidate.
         let before = usize::from(state.since_confirmed).saturating_sub(state.window.len());
         let i = stream.index();
         let per_frame = BYTES_PER_FRAME.get(i).copied().unwrap_or(u16::MAX).max(1);

@@ -10,7 +10,7 @@ use crate::telemetry::{Kind, Stream};
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct DownlinkStats {
-    /// DownlinkFrames emitted, per kind: IMU, encoders, battery, reply (see [`DownlinkStats::frames`]).
+    /// Frames emitted, per kind: IMU, encoders, battery, reply (see [`DownlinkStats::frames`]).
     pub frames: [u32; 4],
     /// Bytes thrown away: rejected candidate starts and bytes that start no frame.
     pub discarded: u32,
@@ -37,13 +37,13 @@ impl DownlinkStats {
         }
     }
 
-    /// DownlinkFrames emitted of this kind.
+    /// Frames emitted of this kind.
     #[must_use]
     pub fn frames_of(&self, kind: Kind) -> u32 {
         self.frames.get(kind_index(kind)).copied().unwrap_or(0)
     }
 
-    /// DownlinkFrames emitted in all.
+    /// Frames emitted in all.
     #[must_use]
     pub fn total_frames(&self) -> u32 {
         self.frames.iter().fold(0u32, |sum, n| sum.wrapping_add(*n))
@@ -55,7 +55,7 @@ impl DownlinkStats {
         self.gaps.get(stream.index()).copied().unwrap_or(0)
     }
 
-    /// DownlinkFrames of this stream missing according to its count bytes.
+    /// Frames of this stream missing according to its count bytes.
     #[must_use]
     pub fn missed_of(&self, stream: Stream) -> u32 {
         self.missed.get(stream.index()).copied().unwrap_or(0)
@@ -91,7 +91,7 @@ const fn kind_index(kind: Kind) -> usize {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct UplinkStats {
-    /// DownlinkFrames emitted.
+    /// Frames emitted.
     pub frames: u32,
     /// Bytes thrown away.
     pub discarded: u32,
