@@ -129,9 +129,12 @@ pub fn score_downlink(sent: &[SentFrame], rx: &Received) -> Score {
     let mut locked_at = Vec::with_capacity(rx.bytes.len());
     for (now, byte) in rx.bytes.iter().enumerate() {
         locked_at.push(parser.lock() == Lock::Locked);
-        if let Some(frame) = parser.push(*byte) {
+        let mut out = parser.push(*byte);
+        while let Some(frame) = out {
             let end = now - parser.buffered();
             judge(frame, end, now, locked_at[end], &mut score);
+            // A chain can prove several frames at once: drain them on this byte.
+            out = parser.poll();
         }
     }
     let now = rx.bytes.len().saturating_sub(1);
@@ -239,9 +242,11 @@ mod tests {
         assert_eq!(score.recalled, 5_000);
         assert_eq!(score.false_frames, 0);
         assert_eq!(score.damaged, 0);
-        // Replies holding a header and each stream's first frame wait two bytes; all else is on time.
+        // Replies nobody awaits (this stream model sends them with no read) wait for the next
+        // frame's count to vouch for them; each stream's first frame waits two bytes; all else
+        // is on time.
         assert!(
-            score.on_time_locked as f64 > 0.99 * score.recalled_locked as f64,
+            score.on_time_locked as f64 > 0.96 * score.recalled_locked as f64,
             "{score:?}"
         );
     }

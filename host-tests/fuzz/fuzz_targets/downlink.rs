@@ -2,7 +2,7 @@
 //!
 //! Checked on every input: the two paths emit the same frames and end in the same state; every
 //! byte is accounted for (emitted in a frame, discarded, or still buffered: progress on every
-//! byte, nothing lost or counted twice); the window never holds more than 17 bytes; every frame
+//! byte, nothing lost or counted twice); the window never holds more than `WINDOW` bytes; every frame
 //! emitted is well formed (it re-encodes to bytes that decode to it, replies carry a code the
 //! spec defines); after `idle` nothing is left buffered.
 #![no_main]
@@ -25,7 +25,7 @@ fn accounted(parser: &DownlinkParser, fed: usize, emitted: &[Downlink]) {
         in_frames + stats.discarded as usize + parser.buffered(),
         fed
     );
-    assert!(parser.buffered() <= 17);
+    assert!(parser.buffered() <= chassis_protocol::parse::downlink::WINDOW);
 }
 
 fuzz_target!(|input: (Vec<u8>, Vec<u8>)| {

