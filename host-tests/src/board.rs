@@ -26,9 +26,53 @@ impl SentFrame {
     }
 }
 
+/// What the telemetry values look like.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Payload {
+    /// A chassis at rest or moving slowly: values around zero, so `FF FA`..`FF FC` turn up as
+    /// a gyro or accel reads -6..-4 (about a tenth of the 16-bit values).
+    Rest,
+    /// Written to fool a parser: about a third of all 16-bit fields read `FF FA`..`FF FC`, a
+    /// third `23` and a reply code; reply values likewise.
+    Adversarial,
+}
+
+/// What the count byte counts (A10: the vendor does not say).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CountModel {
+    /// One counter per stream, each stepping by its own amount (IMU, encoders, battery).
+    PerStream([u8; 3]),
+    /// One counter shared by all three streams, +1 per telemetry frame.
+    Shared,
+    /// A 10 ms time tick: IMU +1, encoders +4, battery +100.
+    Tick,
+}
+
+impl CountModel {
+    /// The models the parser must work under.
+    pub const ALL: [(&'static str, CountModel); 4] = [
+        ("per stream +1", CountModel::PerStream([1, 1, 1])),
+        ("per stream +2/+3/+5", CountModel::PerStream([2, 3, 5])),
+        ("one shared counter", CountModel::Shared),
+        ("10 ms tick", CountModel::Tick),
+    ];
+}
+
+/// A quiet stretch of line before the frame that starts at `offset`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Gap {
+    /// Offset of the first byte after the quiet stretch.
+    pub offset: usize,
+    /// How long the line was quiet, in ms (at least 1).
+    pub ms: u32,
+}
+
 /// The board's telemetry generator.
 #[derive(Clone, Debug)]
 pub struct BoardStream {
+    payload: Payload,
+    counts: CountModel,
+    shared: u8,
     rng: Pcg64Mcg,
     /// Time in microseconds.
     now_us: u64,
@@ -55,6 +99,9 @@ impl BoardStream {
         };
         let seq = [rng.random(), rng.random(), rng.random()];
         BoardStream {
+            payload: Payload::Rest,
+            counts: CountModel::PerStream([1, 1, 1]),
+            shared: 0,
             next_imu_us: rng.random_range(0..10_000),
             next_encoders_us: rng.random_range(0..40_000),
             next_battery_us: rng.random_range(0..1_000_000),
@@ -73,15 +120,46 @@ impl BoardStream {
         }
     }
 
-    /// A small value around zero, as a sensor at rest reads.
+    /// The same board with other payloads and another count model.
+    pub fn with_models(mut self, payload: Payload, counts: CountModel) -> Self {
+        self.payload = payload;
+        self.counts = counts;
+        self.shared = self.rng.random();
+        self
+    }
+
+    /// A small value around zero, as a sensor at rest reads; with adversarial payloads, often a
+    /// header or `#` and a reply code instead.
     fn around_zero(&mut self, spread: i16) -> i16 {
+        if self.payload == Payload::Adversarial {
+            match self.rng.random_range(0..3) {
+                0 => return self.rng.random_range(-6..=-4),
+                1 => return self.hash_and_code() as i16,
+                _ => {}
+            }
+        }
         self.rng.random_range(-spread..=spread)
     }
 
+    /// `23` followed by a reply code the spec defines, as a 16-bit value.
+    fn hash_and_code(&mut self) -> u16 {
+        let codes = [0x01, 0x06, 0x07, 0x08, 0x09, 0x0A, 0x0B, 0x0C, 0x20];
+        0x2300 | codes[self.rng.random_range(0..codes.len())]
+    }
+
     fn next_seq(&mut self, stream: usize) -> u8 {
-        let slot = &mut self.seq[stream];
-        *slot = slot.wrapping_add(1);
-        *slot
+        match self.counts {
+            CountModel::PerStream(steps) => {
+                let slot = &mut self.seq[stream];
+                *slot = slot.wrapping_add(steps[stream]);
+                *slot
+            }
+            CountModel::Shared => {
+                self.shared = self.shared.wrapping_add(1);
+                self.shared
+            }
+            CountModel::Tick => (self.now_us / 10_000) as u8,
+        }
     }
 
     fn imu(&mut self) -> Downlink {
@@ -133,16 +211,31 @@ impl BoardStream {
             Register::MotorVoltage => 1_200,
             _ => self.rng.random_range(0..100_000),
         };
+        let value = if self.payload == Payload::Adversarial && self.rng.random_bool(0.5) {
+            let high = match self.rng.random_range(0..2) {
+                0 => 0xFFFA + self.rng.random_range(0..3),
+                _ => self.hash_and_code(),
+            };
+            (u32::from(high) << 16) | (value & 0xFFFF)
+        } else {
+            value
+        };
         Downlink::Reply(Reply::new(register, value))
     }
 
     /// The next frame the board sends, and advances time past it.
     pub fn next_frame(&mut self) -> Downlink {
+        self.next_frame_after_quiet().0
+    }
+
+    /// The next frame, and how long the line was quiet before it, in µs.
+    fn next_frame_after_quiet(&mut self) -> (Downlink, u64) {
         let due = self
             .next_imu_us
             .min(self.next_encoders_us)
             .min(self.next_battery_us)
             .min(self.next_reply_us);
+        let quiet_us = due.saturating_sub(self.now_us);
         self.now_us = self.now_us.max(due);
         let frame = if due == self.next_imu_us {
             self.next_imu_us += 10_000;
@@ -162,7 +255,32 @@ impl BoardStream {
         };
         // 86.8 us per byte at 115 200 bps, 8N1.
         self.now_us += frame.encode().len() as u64 * 1_000_000 / 11_520;
-        frame
+        (frame, quiet_us)
+    }
+
+    /// [`take`](Self::take), with the quiet stretches of the line: the board sends each frame
+    /// when it falls due, so the line is idle between most frames (about 85 % of the time).
+    /// The bytes are the same as `take` gives; a master that watches the line sees the gaps.
+    pub fn take_with_gaps(&mut self, count: usize) -> (Vec<u8>, Vec<SentFrame>, Vec<Gap>) {
+        let mut bytes = Vec::with_capacity(count * 15);
+        let mut frames = Vec::with_capacity(count);
+        let mut gaps = Vec::new();
+        for _ in 0..count {
+            let (frame, quiet_us) = self.next_frame_after_quiet();
+            // Two characters' time or more is a gap a UART's idle-line detection sees.
+            if quiet_us >= 200 && !bytes.is_empty() {
+                gaps.push(Gap {
+                    offset: bytes.len(),
+                    ms: (quiet_us / 1_000).max(1) as u32,
+                });
+            }
+            frames.push(SentFrame {
+                start: bytes.len(),
+                frame,
+            });
+            bytes.extend_from_slice(&frame.encode());
+        }
+        (bytes, frames, gaps)
     }
 
     /// `count` frames, back to back: the bytes, and each frame with its offset.

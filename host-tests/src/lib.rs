@@ -9,9 +9,11 @@ pub mod channel;
 pub mod score;
 pub mod splice;
 
-pub use board::{BoardStream, SentFrame};
+pub use board::{BoardStream, CountModel, Gap, Payload, SentFrame};
 pub use channel::{Noise, Received};
-pub use score::{Score, Startup, score_downlink, startup, startup_with_idle};
+pub use score::{
+    Score, Startup, score_downlink, score_downlink_with_gaps, startup, startup_with_idle,
+};
 
 /// Cuts `bytes` into consecutive pieces whose lengths are taken from `lengths` in turn (each at
 /// least 1; the whole rest at once if `lengths` is empty): the reads a UART driver might see.

@@ -7,7 +7,7 @@
 //!   without a checksum nobody can tell.)
 //! * **Latency** is how many bytes after a frame's last byte the parser emitted it.
 
-use crate::board::SentFrame;
+use crate::board::{Gap, SentFrame};
 use crate::channel::Received;
 use chassis_protocol::{Downlink, DownlinkParser, DownlinkStats, Lock};
 use std::collections::HashMap;
@@ -82,6 +82,13 @@ impl Score {
 /// Runs `rx` through a new downlink parser, one byte at a time, then tells it the line went
 /// quiet, and scores what it emits against `sent`.
 pub fn score_downlink(sent: &[SentFrame], rx: &Received) -> Score {
+    score_downlink_with_gaps(sent, rx, &[])
+}
+
+/// [`score_downlink`], with the parser told of every quiet stretch of the line
+/// ([`DownlinkParser::quiet`], with its length) before the first received byte that was sent
+/// after it.
+pub fn score_downlink_with_gaps(sent: &[SentFrame], rx: &Received, gaps: &[Gap]) -> Score {
     let by_start: HashMap<usize, usize> =
         sent.iter().enumerate().map(|(i, f)| (f.start, i)).collect();
     let mut emitted_at = vec![false; sent.len()];
@@ -127,7 +134,27 @@ pub fn score_downlink(sent: &[SentFrame], rx: &Received) -> Score {
 
     // Whether the parser was Locked when each received byte arrived.
     let mut locked_at = Vec::with_capacity(rx.bytes.len());
+    let mut gaps = gaps.iter().peekable();
     for (now, byte) in rx.bytes.iter().enumerate() {
+        if let Some(origin) = rx.origin.get(now).copied().flatten() {
+            let mut quiet_ms = 0;
+            while let Some(gap) = gaps.next_if(|g| g.offset <= origin) {
+                quiet_ms += gap.ms;
+            }
+            if quiet_ms > 0 {
+                let end = now.saturating_sub(1);
+                while let Some(frame) = parser.quiet(quiet_ms) {
+                    let at = end - parser.buffered();
+                    judge(
+                        frame,
+                        at,
+                        end,
+                        locked_at.get(at).copied().unwrap_or(false),
+                        &mut score,
+                    );
+                }
+            }
+        }
         locked_at.push(parser.lock() == Lock::Locked);
         let mut out = parser.push(*byte);
         while let Some(frame) = out {

@@ -245,33 +245,3 @@ proptest! {
         }
     }
 }
-
-#[test]
-fn zz_debug() {
-    let (bytes, sent) = BoardStream::new(1942316501171675020, 5.0).take(120);
-    let offset = 190;
-    let mut parser = DownlinkParser::new();
-    for (i, b) in bytes[offset..].iter().enumerate() {
-        if let Some(f) = parser.push(*b) {
-            let real = sent.iter().find(|s| s.frame == f).map(|s| s.start);
-            println!(
-                "out at {} {:?} real start {:?} lock {:?}",
-                i + offset,
-                f,
-                real,
-                parser.lock()
-            );
-            if real.is_none() {
-                break;
-            }
-        }
-    }
-    for f in sent.iter().filter(|f| f.start > 150 && f.start < 330) {
-        println!(
-            "{:4} {:02X?} {:?}",
-            f.start,
-            f.frame.encode().as_slice(),
-            f.frame
-        );
-    }
-}

@@ -226,11 +226,12 @@ impl Counts {
     /// its smallest step, as if the count had continued.
     pub fn skip(&mut self, stream: Stream, count: u8) {
         let i = stream.index();
-        // Two far counts in a row a small step apart: the board's count is there (it moved on,
-        // or was wrongly learnt). Follow it, and learn the step.
+        // Two far counts in a row on certain boundaries: the board's count is there (it moved
+        // on, was wrongly learnt, or steps by more than was learnt: a shared counter steps the
+        // encoders by 5 or 6, a time tick the battery by 100). Follow it, and learn the step.
         if let Some(Some(alt)) = self.alt.get(i).copied() {
             let delta = count.wrapping_sub(alt);
-            if (1..=FIRST_STEP_MAX).contains(&delta) {
+            if (1..=127).contains(&delta) {
                 if let Some(l) = self.last.get_mut(i) {
                     *l = alt;
                 }

@@ -36,8 +36,9 @@
 //! | 8 | Hunting | telemetry, count continues or near | when the chain vouches |
 //! | 9 | Hunting | telemetry, the stream's first | when its own stream's next frame in the chain continues it |
 //! | 10 | Hunting | the awaited reply | when the chain (or a quiet line) vouches |
-//! | 11 | anywhere | a reply nobody awaits | when the next frame's count continues exactly |
-//! | 12 | Hunting | telemetry, count far | never |
+//! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it) |
+//! | 12 | Hunting | a reply nobody awaits | never |
+//! | 13 | Hunting | telemetry, count far | never |
 //!
 //! *The chain vouches* ([`rules::Chain`]) when the frames right after the candidate, back to
 //! back, reach one whose count continues (or is near) its stream's count, counting the
@@ -494,7 +495,9 @@ impl DownlinkParser {
             // A reply nobody awaits that fills the line from a boundary up to the quiet line.
             Chain::Exact => self.lock != Lock::Hunting,
             Chain::Own => false,
-            Chain::Verify | Chain::Rebase => {
+            // A far count on a boundary that fills the line up to the quiet.
+            Chain::Rebase => self.lock != Lock::Hunting,
+            Chain::Verify => {
                 self.lock == Lock::Tentative
                     || matches!(
                         class,
@@ -543,6 +546,21 @@ impl DownlinkParser {
             let Ok(next) = Downlink::decode(bytes) else {
                 return Some(false);
             };
+            if chain == Chain::Exact {
+                // Only the next frame, continuing exactly; a stream's first frame (no count to
+                // judge by) is passed over, a reply is not.
+                match (next.kind(), next.seq()) {
+                    (Kind::Telemetry(stream), Some(seq)) => match counts.rel(stream, seq, at) {
+                        Rel::Continues => return Some(true),
+                        Rel::Unknown => counts.take(stream, seq, false),
+                        Rel::Near | Rel::Far => return Some(false),
+                    },
+                    _ => return Some(false),
+                }
+                pos = end;
+                gap = 0;
+                continue;
+            }
             if let (Kind::Telemetry(stream), Some(seq)) = (next.kind(), next.seq()) {
                 let mut vouches = chain != Chain::Own || own == Some(stream);
                 if vouches && chain == Chain::Own && !counts.has_steps(stream) {

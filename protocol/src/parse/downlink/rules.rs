@@ -32,8 +32,9 @@ pub enum Chain {
     /// streams with no count are passed over. A quiet line right after a candidate whose own
     /// count continues or is near (or an expected reply) also vouches.
     Verify,
-    /// As `Verify`, but only a count that continues exactly vouches; a quiet line vouches only
-    /// when the candidate starts on a boundary (Locked or Tentative) and ends on the quiet.
+    /// Only the very next frame vouches, and only if its count continues exactly (no reply or
+    /// stream's first frame passed over); a quiet line vouches when the candidate starts on a
+    /// boundary (Locked or Tentative) and ends on the quiet.
     Exact,
     /// As `Verify`, but a far count in the chain re-bases its stream instead of failing it (a
     /// damaged count byte on a certain boundary, or a board that restarted its counts).
@@ -85,9 +86,13 @@ pub const fn need(lock: Lock, class: Class) -> Need {
         (Lock::Hunting, Class::First) => Need::Chain(Chain::Own),
         // 10. Hunting, the awaited reply: the next frames (or the quiet line) must vouch.
         (Lock::Hunting, Class::Expected { .. }) => Need::Chain(Chain::Verify),
-        // 11. A reply nobody waits for, anywhere: the next frame must continue its count.
-        (_, Class::Unexpected) => Need::Chain(Chain::Exact),
-        // 12. Hunting, a far count: never.
+        // 11. A reply nobody waits for, on a boundary: the very next frame must continue its
+        //     count exactly.
+        (Lock::Locked | Lock::Tentative, Class::Unexpected) => Need::Chain(Chain::Exact),
+        // 12. A reply nobody waits for, hunting: never (the tail of a damaged frame, `23` and a
+        //     code in its payload, ends right where the next real frame starts).
+        (Lock::Hunting, Class::Unexpected) => Need::Never,
+        // 13. Hunting, a far count: never.
         (Lock::Hunting, Class::Far) => Need::Never,
     }
 }
@@ -161,14 +166,19 @@ mod tests {
     }
 
     #[test]
-    fn row11_a_reply_nobody_waits_for_needs_an_exact_count_after_it() {
-        for lock in [Hunting, Tentative, Locked] {
+    fn row11_a_reply_nobody_waits_for_on_a_boundary_needs_an_exact_count_after_it() {
+        for lock in [Tentative, Locked] {
             assert_eq!(need(lock, Class::Unexpected), Need::Chain(Chain::Exact));
         }
     }
 
     #[test]
-    fn row12_hunting_never_takes_a_far_count() {
+    fn row12_hunting_never_takes_a_reply_nobody_waits_for() {
+        assert_eq!(need(Hunting, Class::Unexpected), Need::Never);
+    }
+
+    #[test]
+    fn row13_hunting_never_takes_a_far_count() {
         assert_eq!(need(Hunting, Class::Far), Need::Never);
     }
 }
