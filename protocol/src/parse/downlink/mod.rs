@@ -38,7 +38,7 @@
 //! | 10 | Hunting | the awaited reply | when the chain (or a quiet line) vouches |
 //! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it) |
 //! | 12 | Hunting | a reply nobody awaits | never |
-//! | 13 | Hunting | telemetry, count far | never |
+//! | 13 | Hunting | telemetry, count far | when its own stream's next two frames in the chain move on from it in step (the board restarted its counts) |
 //!
 //! *The chain vouches* ([`rules::Chain`]) when the frames right after the candidate, back to
 //! back, reach one whose count continues (or is near) its stream's count, counting the
@@ -494,7 +494,7 @@ impl DownlinkParser {
         let quiet_vouches = match chain {
             // A reply nobody awaits that fills the line from a boundary up to the quiet line.
             Chain::Exact => self.lock != Lock::Hunting,
-            Chain::Own => false,
+            Chain::Own | Chain::Restart => false,
             // A far count on a boundary that fills the line up to the quiet.
             Chain::Rebase => self.lock != Lock::Hunting,
             Chain::Verify => {
@@ -562,8 +562,10 @@ impl DownlinkParser {
                 continue;
             }
             if let (Kind::Telemetry(stream), Some(seq)) = (next.kind(), next.seq()) {
-                let mut vouches = chain != Chain::Own || own == Some(stream);
-                if vouches && chain == Chain::Own && !counts.has_steps(stream) {
+                let own_only = matches!(chain, Chain::Own | Chain::Restart);
+                let mut vouches = !own_only || own == Some(stream);
+                let in_step = chain == Chain::Restart || !counts.has_steps(stream);
+                if vouches && own_only && in_step {
                     // No step learnt: sensor bytes drift slowly, so two false frames' "counts"
                     // can be a few apart. Three frames of the stream, equally spaced, vouch.
                     let delta = seq.wrapping_sub(counts.last(stream));
@@ -581,7 +583,9 @@ impl DownlinkParser {
                     Rel::Near if vouches => return Some(chain != Chain::Exact),
                     Rel::Continues | Rel::Near => counts.take(stream, seq, false),
                     Rel::Unknown => counts.take(stream, seq, false),
-                    Rel::Far if chain == Chain::Rebase => counts.take(stream, seq, false),
+                    Rel::Far if matches!(chain, Chain::Rebase | Chain::Restart) => {
+                        counts.take(stream, seq, false);
+                    }
                     Rel::Far => return Some(false),
                 }
             }
