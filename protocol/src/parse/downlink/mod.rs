@@ -26,15 +26,15 @@
 //!
 //! | # | where the candidate starts | what it is | taken |
 //! |---|---|---|---|
-//! | 1 | Locked or Tentative | telemetry, count continues | on its last byte |
+//! | 1 | Locked or Tentative | telemetry, count continues (or fits two streams) | on its last byte |
 //! | 2 | Locked or Tentative | the awaited reply, no telemetry header inside its value | on its last byte |
 //! | 3 | Locked or Tentative | the awaited reply that could hide a cut frame | with a header (or quiet line) after it |
 //! | 4 | Locked | telemetry, count near (frames lost) or the stream's first | with a header (or quiet line) after it |
 //! | 5 | Locked | telemetry, count far | when the chain after it vouches, far counts in it re-based |
 //! | 6 | Tentative | telemetry, count near (the board paused) | with a header (or quiet line) after it |
 //! | 7 | Tentative | telemetry, the stream's first or a far count | when the chain vouches (far counts in it re-based), or it fills the burst up to the next quiet line |
-//! | 8 | Hunting | telemetry, count continues or near | when the chain vouches |
-//! | 9 | Hunting | telemetry, the stream's first | when its own stream's next frame in the chain continues it |
+//! | 8 | Hunting | telemetry, count continues or near (and fits no other stream) | when the chain vouches |
+//! | 9 | Hunting | telemetry, the stream's first, or a count another stream's could explain | when its own stream's next frame in the chain continues it |
 //! | 10 | Hunting | the awaited reply | when the chain (or a quiet line) vouches |
 //! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it) |
 //! | 12 | Hunting | a reply nobody awaits | never |
@@ -80,7 +80,7 @@ pub mod rules;
 
 use super::stats::DownlinkStats;
 use crate::command::Register;
-use crate::telemetry::{self, Downlink, Kind};
+use crate::telemetry::{self, Downlink, Kind, Stream};
 use counts::{Counts, Rel};
 use rules::{Chain, Class, Need};
 
@@ -422,6 +422,12 @@ impl DownlinkParser {
             Downlink::Reply(_) => Class::Unexpected,
             _ => match (frame.kind(), frame.seq()) {
                 (Kind::Telemetry(stream), Some(seq)) => match self.counts.rel(stream, seq, at) {
+                    Rel::Continues | Rel::Near
+                        if self.lock == Lock::Hunting
+                            && self.other_stream_fits(stream, seq, at) =>
+                    {
+                        Class::Ambiguous
+                    }
                     Rel::Continues => Class::Continues,
                     Rel::Near => Class::Near,
                     Rel::Unknown => Class::First,
@@ -430,6 +436,14 @@ impl DownlinkParser {
                 _ => Class::Unexpected,
             },
         }
+    }
+
+    /// Whether `seq` would continue (or be near) a stream other than `stream`.
+    fn other_stream_fits(&self, stream: Stream, seq: u8, at: usize) -> bool {
+        Stream::ALL.iter().any(|other| {
+            *other != stream
+                && matches!(self.counts.rel(*other, seq, at), Rel::Continues | Rel::Near)
+        })
     }
 
     /// Judges the candidate at the front of the window. `quiet`: the line has gone quiet, so
@@ -497,12 +511,10 @@ impl DownlinkParser {
             Chain::Own | Chain::Restart => false,
             // A far count on a boundary that fills the line up to the quiet.
             Chain::Rebase => self.lock != Lock::Hunting,
+            // Hunting, a quiet line vouches only for the awaited reply: a false frame in a
+            // damaged frame's tail ends exactly where the line goes quiet.
             Chain::Verify => {
-                self.lock == Lock::Tentative
-                    || matches!(
-                        class,
-                        Class::Continues | Class::Near | Class::Expected { .. }
-                    )
+                self.lock == Lock::Tentative || matches!(class, Class::Expected { .. })
             }
         };
         let mut pos = len;

@@ -10,6 +10,10 @@ pub enum Class {
     Continues,
     /// Telemetry whose count is a few steps on (frames lost).
     Near,
+    /// Telemetry whose count continues (or is near) its stream's, but would continue another
+    /// stream's too: what a false frame in a damaged frame's tail, ending on that frame's count
+    /// byte, looks like when the streams share a counter or a time tick.
+    Ambiguous,
     /// Telemetry of a stream with no count known (its first frame, or after forgetting).
     First,
     /// Telemetry whose count is anything else.
@@ -70,7 +74,7 @@ pub enum Need {
 pub const fn need(lock: Lock, class: Class) -> Need {
     match (lock, class) {
         // 1. Aligned, the count continues: the fast path.
-        (Lock::Locked | Lock::Tentative, Class::Continues) => Need::Now,
+        (Lock::Locked | Lock::Tentative, Class::Continues | Class::Ambiguous) => Need::Now,
         // 2. Aligned, the awaited reply, nothing in its value that could be a cut frame.
         (Lock::Locked | Lock::Tentative, Class::Expected { clean: true }) => Need::Now,
         // 3. Aligned, the awaited reply that could hide a cut.
@@ -86,8 +90,9 @@ pub const fn need(lock: Lock, class: Class) -> Need {
         (Lock::Tentative, Class::First | Class::Far) => Need::Chain(Chain::Rebase),
         // 8. Hunting, a plausible count: the next frames must vouch.
         (Lock::Hunting, Class::Continues | Class::Near) => Need::Chain(Chain::Verify),
-        // 9. Hunting, a stream's first frame: its own stream's next frame must continue it.
-        (Lock::Hunting, Class::First) => Need::Chain(Chain::Own),
+        // 9. Hunting, a stream's first frame, or a count another stream's could explain: its
+        //    own stream's next frame must continue it.
+        (Lock::Hunting, Class::First | Class::Ambiguous) => Need::Chain(Chain::Own),
         // 10. Hunting, the awaited reply: the next frames (or the quiet line) must vouch.
         (Lock::Hunting, Class::Expected { .. }) => Need::Chain(Chain::Verify),
         // 11. A reply nobody waits for, on a boundary: the very next frame must continue its
@@ -109,8 +114,10 @@ mod tests {
 
     #[test]
     fn row1_aligned_and_continuing_is_taken_at_once() {
-        assert_eq!(need(Locked, Class::Continues), Need::Now);
-        assert_eq!(need(Tentative, Class::Continues), Need::Now);
+        for lock in [Locked, Tentative] {
+            assert_eq!(need(lock, Class::Continues), Need::Now);
+            assert_eq!(need(lock, Class::Ambiguous), Need::Now);
+        }
     }
 
     #[test]
@@ -158,8 +165,9 @@ mod tests {
     }
 
     #[test]
-    fn row9_hunting_a_first_frame_needs_its_own_stream() {
+    fn row9_hunting_a_first_frame_or_an_ambiguous_count_needs_its_own_stream() {
         assert_eq!(need(Hunting, Class::First), Need::Chain(Chain::Own));
+        assert_eq!(need(Hunting, Class::Ambiguous), Need::Chain(Chain::Own));
     }
 
     #[test]
