@@ -141,6 +141,19 @@ impl Buf {
         self.len() >= WINDOW
     }
 
+    /// Appends one byte if there is room at the end; `false` if not (nothing done).
+    #[inline]
+    fn push(&mut self, byte: u8) -> bool {
+        match self.bytes.get_mut(usize::from(self.end)) {
+            Some(slot) => {
+                *slot = byte;
+                self.end = self.end.saturating_add(1);
+                true
+            }
+            None => false,
+        }
+    }
+
     /// Appends what fits of `bytes`; returns how many.
     #[inline]
     fn extend(&mut self, bytes: &[u8]) -> usize {
@@ -189,8 +202,8 @@ enum Verdict {
     NeedMore,
     /// The first byte starts no frame: drop it.
     Reject,
-    /// A frame of this length, and its count's relation (for the counters).
-    Accept(Downlink, usize),
+    /// A frame of this length, and what it was judged to be.
+    Accept(Downlink, usize, Class),
 }
 
 /// The board → master streaming parser. See the [module docs](self) for the rules.
@@ -229,6 +242,9 @@ pub struct DownlinkParser {
     drain: bool,
     /// Bytes consumed since the last frame taken (saturating).
     since_frame: u16,
+    /// The length of the frame whose header is at the front of the window, once judging it
+    /// has needed more bytes (0: none known): until it is complete, a byte is only stored.
+    pending: u8,
     stats: DownlinkStats,
 }
 
@@ -255,6 +271,7 @@ impl DownlinkParser {
             expect: None,
             drain: false,
             since_frame: 0,
+            pending: 0,
             stats: DownlinkStats::new(),
         }
     }
@@ -266,6 +283,14 @@ impl DownlinkParser {
     /// [`poll`](Self::poll) or [`quiet`](Self::quiet)), never lost.
     #[inline]
     pub fn push(&mut self, byte: u8) -> Option<Downlink> {
+        // The fast path: a frame whose length is known is still incomplete after this byte;
+        // nothing can be decided, so the byte is only stored.
+        if !self.drain
+            && usize::from(self.pending) > self.buf.len().saturating_add(1)
+            && self.buf.push(byte)
+        {
+            return None;
+        }
         let ready = if self.drain { self.poll() } else { None };
         self.append(&[byte]);
         match ready {
@@ -373,16 +398,19 @@ impl DownlinkParser {
     }
 
     fn run(&mut self, quiet: bool) -> Option<Downlink> {
+        self.pending = 0;
         loop {
             match self.judge(quiet) {
                 Verdict::NeedMore => {
                     self.drain = false;
+                    self.pending = self.front_len();
                     return None;
                 }
                 Verdict::Reject => self.reject(),
-                Verdict::Accept(frame, len) => {
-                    self.accept(&frame, len);
-                    self.drain = true;
+                Verdict::Accept(frame, len, class) => {
+                    self.accept(&frame, len, class);
+                    // Another frame can be ready at once only if bytes are left.
+                    self.drain = self.buf.len() > 0;
                     return Some(frame);
                 }
             }
@@ -398,6 +426,18 @@ impl DownlinkParser {
             }
             let taken = self.buf.extend(bytes);
             bytes = bytes.get(taken..).unwrap_or(&[]);
+        }
+    }
+
+    /// The length of the frame whose header is at the front of the window, if it is not yet
+    /// complete (0 otherwise).
+    fn front_len(&self) -> u8 {
+        match self.buf.as_slice() {
+            [first, second, ..] => match Kind::from_header(*first, *second) {
+                Some(kind) if kind.len() > self.buf.len() => u8::try_from(kind.len()).unwrap_or(0),
+                _ => 0,
+            },
+            _ => 0,
         }
     }
 
@@ -478,7 +518,7 @@ impl DownlinkParser {
             Need::Chain(chain) => self.chain(buf, &frame, len, class, chain, quiet),
         };
         match taken {
-            Some(true) => Verdict::Accept(frame, len),
+            Some(true) => Verdict::Accept(frame, len, class),
             Some(false) => Verdict::Reject,
             None => Verdict::NeedMore,
         }
@@ -630,23 +670,19 @@ impl DownlinkParser {
     }
 
     /// Consumes an accepted frame: counts, counters, lock.
-    fn accept(&mut self, frame: &Downlink, len: usize) {
+    fn accept(&mut self, frame: &Downlink, len: usize, class: Class) {
         // A far count taken on a certain boundary is believed only if its own stream's next
         // frame continues it (the board moved its count on); otherwise it is a damaged count
         // byte, and the stream moves on by a step.
-        let believed = match (frame.kind(), frame.seq()) {
-            (Kind::Telemetry(stream), Some(seq)) => {
-                self.counts.rel(stream, seq, 0) != Rel::Far
-                    || self.chain(
-                        self.buf.as_slice(),
-                        frame,
-                        len,
-                        Class::Far,
-                        Chain::Own,
-                        false,
-                    ) == Some(true)
+        let believed = class != Class::Far
+            || self.chain(self.buf.as_slice(), frame, len, class, Chain::Own, false) == Some(true);
+        // Frames lost (a near count) teach no step.
+        let near = match (class, frame.kind(), frame.seq()) {
+            (Class::Near, ..) => true,
+            (Class::Ambiguous, Kind::Telemetry(stream), Some(seq)) => {
+                self.counts.rel(stream, seq, 0) == Rel::Near
             }
-            _ => true,
+            _ => false,
         };
         self.buf.drop_front(len);
         self.counts.bytes(len);
@@ -655,8 +691,6 @@ impl DownlinkParser {
         match (frame.kind(), frame.seq(), frame) {
             (Kind::Telemetry(stream), Some(seq), _) if !believed => self.counts.skip(stream, seq),
             (Kind::Telemetry(stream), Some(seq), _) => {
-                // Frames lost teach no step.
-                let near = self.counts.rel(stream, seq, 0) == Rel::Near;
                 if near {
                     self.stats
                         .count_gap(stream, self.counts.missed(stream, seq));
