@@ -1,11 +1,13 @@
-//! The workspace's tasks, run with `cargo xtask <task>` (an alias in `.cargo/config.toml`).
+//! The workspace's tasks, run with `cargo xtask <task>` (an alias in `.cargo/config.toml`):
+//! `demo`, `test`, `sweep`, `bench`, `fuzz [SECONDS]`.
 //!
 //! | task | what it does |
 //! |---|---|
 //! | `demo` | the main job: today a host demo (frames built, a noisy board stream parsed) |
 //! | `test` | everything CI checks: format, lints, tests, docs, `no_std` builds for Cortex-M, the link-time no-panic proof, and a short, repeatable run of every fuzz target (fixed seed and run count) |
 //! | `fuzz [SECONDS]` | only the fuzz targets, each for SECONDS (default 30), exploring: random seed, corpora kept |
-//! | `sweep` | the full noise sweep of the downlink parser (about a minute; not part of `test`) |
+//! | `sweep` | the full noise sweep of the downlink parser over every stream model (a few minutes; not part of `test`) |
+//! | `bench` | the parser beside its peers (sbus-rs, uf-crsf, crsf) in one run: a table with the ratios (not part of `test`, which only builds it) |
 //!
 //! Each task installs what it needs (rustup targets, the nightly toolchain and cargo-fuzz)
 //! before it runs, so a fresh machine with rustup and cargo needs nothing else.
@@ -21,6 +23,7 @@ fn main() -> ExitCode {
         "demo" => demo(),
         "test" => test(),
         "sweep" => sweep(),
+        "bench" => bench(),
         "fuzz" => {
             let seconds = std::env::args().nth(2).unwrap_or_else(|| "30".to_string());
             match seconds.parse::<u32>() {
@@ -31,7 +34,7 @@ fn main() -> ExitCode {
             }
         }
         _ => {
-            eprintln!("usage: cargo xtask <demo | test | sweep | fuzz [SECONDS]>");
+            eprintln!("usage: cargo xtask <demo | test | sweep | bench | fuzz [SECONDS]>");
             return ExitCode::from(2);
         }
     };
@@ -122,6 +125,100 @@ fn demo() -> Result<(), String> {
     host_tests("--example", "demo", &[])
 }
 
+/// Runs the parser benchmark (`host-tests/benches/parsers.rs`: this parser and its peers in one
+/// run) and prints one table with the ratios the parser issue sets as goals.
+fn bench() -> Result<(), String> {
+    let program = cargo_program();
+    let args = [
+        "bench",
+        "-p",
+        "chassis-host-tests",
+        "--bench",
+        "parsers",
+        "--",
+        "--noplot",
+    ];
+    eprintln!("$ cargo {}", args.join(" "));
+    let output = Command::new(&program)
+        .args(args)
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .map_err(|e| format!("could not start cargo bench: {e}"))?;
+    if !output.status.success() {
+        return Err(format!("cargo bench failed ({})", output.status));
+    }
+    let text = String::from_utf8_lossy(&output.stdout);
+    // Criterion prints `parsers/<name>` and, a line or two later, `thrpt: [low mid high]`.
+    let mut rates: Vec<(String, f64)> = Vec::new();
+    let mut name = None;
+    for line in text.lines() {
+        if let Some(n) = line.trim().strip_prefix("parsers/") {
+            name = Some(n.trim().to_string());
+        } else if let (Some(n), Some(rest)) = (&name, line.trim().strip_prefix("thrpt:")) {
+            let fields: Vec<&str> = rest
+                .trim_matches(|c: char| c == '[' || c == ']' || c.is_whitespace())
+                .split_whitespace()
+                .collect();
+            if let [_, _, mid, unit, ..] = fields.as_slice() {
+                let value: f64 = mid.parse().map_err(|e| format!("{mid}: {e}"))?;
+                let mib = match *unit {
+                    "GiB/s" => value * 1024.0,
+                    "KiB/s" => value / 1024.0,
+                    _ => value,
+                };
+                rates.push((n.clone(), mib * 1.048_576));
+            }
+            name = None;
+        }
+    }
+    let rate = |n: &str| rates.iter().find(|(k, _)| k == n).map(|(_, v)| *v);
+    println!("| parser and stream | MB/s |");
+    println!("|---|---|");
+    for (n, v) in &rates {
+        println!("| {n} | {v:.0} |");
+    }
+    let ratio = |a: &str, b: &str| match (rate(a), rate(b)) {
+        (Some(a), Some(b)) if b > 0.0 => a / b,
+        _ => f64::NAN,
+    };
+    println!("\n| goal | ratio | met |");
+    println!("|---|---|---|");
+    for (goal, r, want) in [
+        (
+            "byte path ≥ 2 × sbus-rs",
+            ratio("byte path: chassis telemetry", "byte path: sbus-rs"),
+            2.0,
+        ),
+        (
+            "slice path ≥ 2 × uf-crsf",
+            ratio("slice path: chassis telemetry", "slice path: uf-crsf"),
+            2.0,
+        ),
+        (
+            "random bytes ≥ ½ telemetry (byte path)",
+            ratio(
+                "byte path: chassis random bytes",
+                "byte path: chassis telemetry",
+            ),
+            0.5,
+        ),
+        (
+            "random bytes ≥ ½ telemetry (slice path)",
+            ratio(
+                "slice path: chassis random bytes",
+                "slice path: chassis telemetry",
+            ),
+            0.5,
+        ),
+    ] {
+        println!(
+            "| {goal} | {r:.2} | {} |",
+            if r >= want { "yes" } else { "no" }
+        );
+    }
+    Ok(())
+}
+
 fn sweep() -> Result<(), String> {
     host_tests("--bin", "noise-sweep", &[])
 }
@@ -194,6 +291,15 @@ fn test() -> Result<(), String> {
         let doc = ["doc", "-p", "chassis-protocol", "--no-deps", features];
         run_with(&cargo_program(), &doc, &[("RUSTDOCFLAGS", "-D warnings")])?;
     }
+    // The benchmarks build (running them is `cargo xtask bench`: timings do not belong in CI).
+    cargo(&[
+        "bench",
+        "-p",
+        "chassis-host-tests",
+        "--bench",
+        "parsers",
+        "--no-run",
+    ])?;
     msrv()?;
     fuzz(FuzzRun::Repeatable)
 }
