@@ -308,9 +308,10 @@ pub fn simulator_stream(seed: u64, count: usize) -> (Vec<u8>, Vec<SentFrame>) {
     (bytes, frames)
 }
 
-/// [`simulator_stream`], with where each burst of bytes ends: the board sends what falls due in
-/// one millisecond back to back, then the line is idle until the next frame is due (telemetry
-/// takes about 15 % of the line). Every burst ends on a frame boundary.
+/// [`simulator_stream`], with where each burst of bytes ends: the board sends what falls due
+/// back to back, at the line's pace, then the line is idle until the next frame is due
+/// (telemetry takes about 15 % of the line). A burst ends after a millisecond with no byte;
+/// every burst ends on a frame boundary.
 pub fn simulator_bursts(seed: u64, count: usize) -> (Vec<u8>, Vec<SentFrame>, Vec<usize>) {
     use chassis_protocol::sim::{Board, SimConfig};
     use chassis_protocol::{Kind, Register, Setting};
@@ -332,9 +333,14 @@ pub fn simulator_bursts(seed: u64, count: usize) -> (Vec<u8>, Vec<SentFrame>, Ve
         board.advance(ms);
         let n = board.transmit(&mut buf);
         bytes.extend_from_slice(&buf[..n]);
-        if n > 0 {
+        // The simulated line carries bytes at 115 200 bps, so a frame spans two milliseconds;
+        // a burst ends when a millisecond passes with no byte.
+        if n == 0 && burst_ends.last() != Some(&bytes.len()) && !bytes.is_empty() {
             burst_ends.push(bytes.len());
         }
+    }
+    if burst_ends.last() != Some(&bytes.len()) {
+        burst_ends.push(bytes.len());
     }
     let mut frames = Vec::with_capacity(count);
     let mut at = 0;

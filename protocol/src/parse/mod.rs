@@ -2,13 +2,14 @@
 //!
 //! | parser | direction | emits | state |
 //! |---|---|---|---|
-//! | [`DownlinkParser`] | board → master | [`Downlink`](crate::Downlink) | 32 bytes |
-//! | [`UplinkParser`] | master → board | [`Command`](crate::Command) | 13 bytes |
+//! | [`DownlinkParser`] | board → master | [`Downlink`](crate::Downlink) | 204 bytes (a 96-byte window, learnt counts, counters) |
+//! | [`UplinkParser`] | master → board | [`Command`](crate::Command) | 28 bytes |
 //!
 //! Both are `const fn new()`, take bytes one at a time ([`push`](DownlinkParser::push)) or a
 //! slice at a time ([`push_slice`](DownlinkParser::push_slice), which returns the bytes not yet
 //! consumed so none is ever dropped between calls), never allocate and never panic. Neither
-//! knows about time: a caller that can tell when the line goes quiet says so with `idle()`.
+//! reads a clock: a caller that can tell when the line goes quiet says so (`quiet(ms)` on the
+//! downlink parser, `idle()` on the uplink one).
 
 pub mod downlink;
 pub mod stats;
