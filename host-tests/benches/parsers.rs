@@ -123,6 +123,9 @@ fn crsf_slices(bytes: &[u8]) -> usize {
     n
 }
 
+/// A benchmark: its name, its stream, and the parser run over it (frames found).
+type Run<'a> = (&'a str, &'a [u8], fn(&[u8]) -> usize);
+
 fn benches(c: &mut Criterion) {
     let telemetry = telemetry();
     let random = random();
@@ -152,7 +155,7 @@ fn benches(c: &mut Criterion) {
         .sample_size(11)
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(2));
-    let runs: [(&str, &[u8], fn(&[u8]) -> usize); 7] = [
+    let runs: [Run; 7] = [
         ("byte path: chassis telemetry", &telemetry, ours_bytewise),
         ("byte path: sbus-rs", &sbus, sbus_bytewise),
         ("byte path: chassis random bytes", &random, ours_bytewise),
