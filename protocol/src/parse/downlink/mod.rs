@@ -604,8 +604,10 @@ impl DownlinkParser {
                 match (next.kind(), next.seq()) {
                     (Kind::Telemetry(stream), Some(seq)) => match counts.rel(stream, seq, at) {
                         Rel::Continues => return Some(true),
+                        // On a certain boundary, frames lost upstream.
+                        Rel::Near => return Some(self.lock == Lock::Locked),
                         Rel::Unknown => counts.take(stream, seq, false),
-                        Rel::Near | Rel::Far => return Some(false),
+                        Rel::Far => return Some(false),
                     },
                     _ => return Some(false),
                 }

@@ -36,9 +36,10 @@ pub enum Chain {
     /// streams with no count are passed over. A quiet line right after a candidate whose own
     /// count continues or is near (or an expected reply) also vouches.
     Verify,
-    /// Only the very next frame vouches, and only if its count continues exactly (no reply or
-    /// stream's first frame passed over); a quiet line vouches when the candidate starts on a
-    /// boundary (Locked or Tentative) and ends on the quiet.
+    /// Only the next frame vouches (a stream's first frame is passed over, a reply is not), and
+    /// only if its count continues exactly, or, on a certain boundary (Locked), is near; a quiet
+    /// line vouches when the candidate starts on a boundary (Locked or Tentative) and ends on
+    /// the quiet.
     Exact,
     /// As `Verify`, but a far count in the chain re-bases its stream instead of failing it (a
     /// damaged count byte on a certain boundary, or a board that restarted its counts).
