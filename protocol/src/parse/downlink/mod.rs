@@ -285,11 +285,32 @@ impl DownlinkParser {
     pub fn push(&mut self, byte: u8) -> Option<Downlink> {
         // The fast path: a frame whose length is known is still incomplete after this byte;
         // nothing can be decided, so the byte is only stored.
-        if !self.drain
-            && usize::from(self.pending) > self.buf.len().saturating_add(1)
-            && self.buf.push(byte)
-        {
-            return None;
+        if !self.drain {
+            if usize::from(self.pending) > self.buf.len().saturating_add(1) {
+                if self.buf.push(byte) {
+                    return None;
+                }
+            } else if self.pending == 0 {
+                // A frame's first two bytes: with the first, nothing can be decided; with the
+                // second, the header gives the length to wait for.
+                let first = match self.buf.as_slice() {
+                    [] => None,
+                    [first] => Some(*first),
+                    _ => Some(0),
+                };
+                match (self.buf.len(), first) {
+                    (0, _) if Kind::may_start(byte) && self.buf.push(byte) => return None,
+                    (1, Some(first)) => {
+                        if let Some(kind) = Kind::from_header(first, byte) {
+                            if self.buf.push(byte) {
+                                self.pending = u8::try_from(kind.len()).unwrap_or(0);
+                                return None;
+                            }
+                        }
+                    }
+                    _ => {}
+                }
+            }
         }
         let ready = if self.drain { self.poll() } else { None };
         self.append(&[byte]);
@@ -310,7 +331,16 @@ impl DownlinkParser {
             }
         }
         while !bytes.is_empty() {
-            let step = self.bytes_before_decision().max(1).min(bytes.len());
+            // A frame whose header is (or starts) at the front is taken whole: nothing can be
+            // decided before its last byte.
+            let step = match (self.buf.as_slice(), bytes) {
+                ([], [a, b, ..]) => Kind::from_header(*a, *b).map_or(1, Kind::len),
+                ([a], [b, ..]) => {
+                    Kind::from_header(*a, *b).map_or(1, |kind| kind.len().saturating_sub(1))
+                }
+                _ => self.bytes_before_decision(),
+            };
+            let step = step.max(1).min(bytes.len());
             let (now, later) = bytes.split_at_checked(step).unwrap_or((bytes, &[]));
             self.append(now);
             bytes = later;
