@@ -241,3 +241,36 @@ fn case7_no_start_offset_gives_a_false_frame() {
         }
     }
 }
+
+/// Case 8: a motors frame whose payload ends in `FF FE 02`, repeated back to back, started 3
+/// bytes before the end of the first: the master → board parser took every frame at the false
+/// phase and never realigned. On a line with no gap at all the two phases cannot be told apart
+/// by any parser: the false phase is itself a valid stream of valid motors frames (shown below).
+/// A master leaves the line quiet between commands (it sends one, then waits for its next
+/// period); reported with `idle()`, the parser realigns at the first gap.
+#[test]
+fn case8_the_uplink_parser_realigns_at_the_masters_gaps() {
+    use chassis_protocol::{Command, Motors, UplinkParser};
+    let frame: [u8; 12] = [
+        0xFF, 0xFE, 0x02, 0x00, 0x01, 0x00, 0x02, 0x00, 0x03, 0xFF, 0xFE, 0x02,
+    ];
+    let real = Command::decode(&frame).unwrap();
+    // The false phase: three bytes of one frame and nine of the next, a valid frame too.
+    let shifted: Vec<u8> = frame[9..].iter().chain(&frame[..9]).copied().collect();
+    assert!(matches!(
+        Command::decode(&shifted),
+        Ok(Command::Motors(Motors { .. }))
+    ));
+    assert_ne!(Command::decode(&shifted).unwrap(), real);
+
+    // With the master's gaps reported: every frame after the cut one.
+    let mut p = UplinkParser::new();
+    let mut out = Vec::new();
+    out.extend(p.frames(&frame[9..]));
+    p.idle();
+    for _ in 0..18 {
+        out.extend(p.frames(&frame));
+        p.idle();
+    }
+    assert_eq!(out, vec![real; 18]);
+}
