@@ -25,7 +25,7 @@ use embedded_io_async::{Read, Write as IoWrite};
 pub const MAX_WAIT_MS: u64 = 10;
 
 /// Waits in a row that see the clock stand still before a request gives up with
-/// [`Error::ClockStalled`].
+/// [`CoreError::ClockStalled`].
 pub const STALL_WAITS: u32 = 10_000;
 
 /// The async driver: owns the UART, the clock and the delay (give them back with
@@ -227,8 +227,6 @@ where
     }
 
     async fn finish(&mut self) -> Result<Outcome, Error<U::Error>> {
-        let mut stalled = 0u32;
-        let mut last = None;
         loop {
             let now = match self.pump().await {
                 Ok((_, now)) => now,
@@ -237,18 +235,8 @@ where
                     return Err(e);
                 }
             };
-            if let Some(outcome) = self.core.take_outcome() {
+            if let Some(outcome) = self.core.settle(now, self.rx.is_empty(), STALL_WAITS) {
                 return outcome.map_err(Error::Core);
-            }
-            if last == Some(now) && self.rx.is_empty() {
-                stalled = stalled.saturating_add(1);
-                if stalled >= STALL_WAITS {
-                    self.core.abort();
-                    return Err(Error::ClockStalled);
-                }
-            } else {
-                stalled = 0;
-                last = Some(now);
             }
         }
     }

@@ -30,7 +30,7 @@ use crate::registers::Snapshot;
 use embedded_io::{Read, ReadReady, Write as IoWrite};
 
 /// Polls in a row that see the clock stand still and no byte come before a wait gives up with
-/// [`Error::ClockStalled`] (a millisecond clock that never moves would otherwise hang a read).
+/// [`CoreError::ClockStalled`] (a millisecond clock that never moves would otherwise hang a read).
 /// A million polls take far longer than a millisecond on any microcontroller.
 pub const STALL_POLLS: u32 = 1_000_000;
 
@@ -213,26 +213,14 @@ where
 
     /// Pumps until the request in progress ends. Any error ends it (nothing stays busy).
     fn finish(&mut self) -> Result<Outcome, Error<U::Error>> {
-        let mut stalled = 0u32;
-        let mut last = None;
         loop {
             let now = self.clock.now_ms();
             if let Err(e) = self.pump(now) {
                 self.core.abort();
                 return Err(e);
             }
-            if let Some(outcome) = self.core.take_outcome() {
+            if let Some(outcome) = self.core.settle(now, self.rx.is_empty(), STALL_POLLS) {
                 return outcome.map_err(Error::Core);
-            }
-            if last == Some(now) && self.rx.is_empty() {
-                stalled = stalled.saturating_add(1);
-                if stalled >= STALL_POLLS {
-                    self.core.abort();
-                    return Err(Error::ClockStalled);
-                }
-            } else {
-                stalled = 0;
-                last = Some(now);
             }
         }
     }

@@ -222,6 +222,8 @@ pub enum CoreError {
     TurnInProgress,
     /// The request was ended by [`DriverCore::stop`] (which cancels a turn first).
     Aborted,
+    /// The clock stood still while a request waited: time never came to end the wait.
+    ClockStalled,
 }
 
 impl fmt::Display for CoreError {
@@ -238,6 +240,7 @@ impl fmt::Display for CoreError {
             CoreError::Busy => f.write_str("a request is already in progress"),
             CoreError::TurnInProgress => f.write_str("a turn is still outstanding"),
             CoreError::Aborted => f.write_str("the request was ended by a stop"),
+            CoreError::ClockStalled => f.write_str("the clock stood still while waiting"),
         }
     }
 }
@@ -254,8 +257,6 @@ pub enum Error<E> {
     Transport(E),
     /// The UART accepted no bytes (a write returned 0).
     WriteZero,
-    /// The clock stood still while the driver waited: time never came to end the wait.
-    ClockStalled,
     /// The driver's logic refused or found something wrong.
     Core(CoreError),
 }
@@ -282,7 +283,6 @@ impl<E: fmt::Debug> fmt::Display for Error<E> {
         match self {
             Error::Transport(e) => write!(f, "UART error: {e:?}"),
             Error::WriteZero => f.write_str("the UART accepted no bytes"),
-            Error::ClockStalled => f.write_str("the clock stood still while waiting"),
             Error::Core(e) => fmt::Display::fmt(e, f),
         }
     }

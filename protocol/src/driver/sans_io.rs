@@ -309,12 +309,15 @@ pub struct DriverCore {
     /// The angle of the outstanding turn, in 0.1°.
     turn_deci_degrees: i32,
     failsafe_stops: u32,
+    /// Waits in a row, while a request runs, that saw the clock stand still with nothing read.
+    stalled: u32,
+    stalled_at: Option<u64>,
 }
 
 // RAM budget of the core (the parser 204 bytes with its 96-byte window, the request in
-// progress 104, latest frames, stream figures, timers): 656 bytes on 64-bit hosts.
+// progress 104, latest frames, stream figures, timers): 680 bytes on 64-bit hosts.
 const _: () = assert!(
-    core::mem::size_of::<DriverCore>() <= 672,
+    core::mem::size_of::<DriverCore>() <= 688,
     "DriverCore over its RAM budget"
 );
 
@@ -348,6 +351,8 @@ impl DriverCore {
             turning: false,
             turn_deci_degrees: 0,
             failsafe_stops: 0,
+            stalled: 0,
+            stalled_at: None,
         }
     }
 
@@ -450,6 +455,8 @@ impl DriverCore {
     pub fn abort(&mut self) {
         self.job = None;
         self.outcome = None;
+        self.stalled = 0;
+        self.stalled_at = None;
     }
 
     /// Whether a request is in progress.
@@ -478,6 +485,34 @@ impl DriverCore {
     /// How the last request ended, once it has (taken once).
     pub fn take_outcome(&mut self) -> Option<Result<Outcome, CoreError>> {
         self.outcome.take()
+    }
+
+    /// What a shell asks after each turn of its pump while a request runs: the request's end,
+    /// if it has ended, or [`CoreError::ClockStalled`] once `limit` turns in a row saw the clock
+    /// stand still with nothing read (`idle`): time will never end the wait. A stalled request is
+    /// aborted.
+    pub fn settle(
+        &mut self,
+        now_ms: u64,
+        idle: bool,
+        limit: u32,
+    ) -> Option<Result<Outcome, CoreError>> {
+        if let Some(outcome) = self.outcome.take() {
+            self.stalled = 0;
+            return Some(outcome);
+        }
+        if idle && self.stalled_at == Some(now_ms) {
+            self.stalled = self.stalled.saturating_add(1);
+            if self.stalled >= limit {
+                self.stalled = 0;
+                self.abort();
+                return Some(Err(CoreError::ClockStalled));
+            }
+        } else {
+            self.stalled = 0;
+            self.stalled_at = Some(now_ms);
+        }
+        None
     }
 
     // ----- the pump: what the shells call -----
