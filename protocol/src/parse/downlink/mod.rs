@@ -300,6 +300,11 @@ impl DownlinkParser {
                 };
                 match (self.buf.len(), first) {
                     (0, _) if Kind::may_start(byte) && self.buf.push(byte) => return None,
+                    // A byte that starts no frame, with nothing before it: thrown away at once.
+                    (0, _) if !Kind::may_start(byte) => {
+                        self.discard();
+                        return None;
+                    }
                     (1, Some(first)) => {
                         if let Some(kind) = Kind::from_header(first, byte) {
                             if self.buf.push(byte) {
@@ -331,6 +336,17 @@ impl DownlinkParser {
             }
         }
         while !bytes.is_empty() {
+            // With nothing kept, bytes that start no frame are thrown away at once.
+            if self.buf.len() == 0 {
+                let junk = bytes.iter().take_while(|b| !Kind::may_start(**b)).count();
+                if junk > 0 {
+                    for _ in 0..junk {
+                        self.discard();
+                    }
+                    bytes = bytes.get(junk..).unwrap_or(&[]);
+                    continue;
+                }
+            }
             // A frame whose header is (or starts) at the front is taken whole: nothing can be
             // decided before its last byte.
             let step = match (self.buf.as_slice(), bytes) {
@@ -681,6 +697,11 @@ impl DownlinkParser {
     /// Drops the candidate's first byte and goes hunting.
     fn reject(&mut self) {
         self.buf.drop_front(1);
+        self.discard();
+    }
+
+    /// Counts one byte thrown away (already out of the window, or never in it).
+    fn discard(&mut self) {
         self.consumed(1);
         self.stats.discarded = self.stats.discarded.wrapping_add(1);
         if self.lock != Lock::Hunting {
