@@ -242,9 +242,10 @@ pub struct DownlinkParser {
     drain: bool,
     /// Bytes consumed since the last frame taken (saturating).
     since_frame: u16,
-    /// The length of the frame whose header is at the front of the window, once judging it
-    /// has needed more bytes (0: none known): until it is complete, a byte is only stored.
-    pending: u8,
+    /// Bytes still missing from the frame whose header is at the front of the window, once
+    /// judging it has needed more (0: none known; always 0 while `drain`): until the last one, a
+    /// byte is only stored.
+    missing: u8,
     stats: DownlinkStats,
 }
 
@@ -271,7 +272,7 @@ impl DownlinkParser {
             expect: None,
             drain: false,
             since_frame: 0,
-            pending: 0,
+            missing: 0,
             stats: DownlinkStats::new(),
         }
     }
@@ -285,36 +286,34 @@ impl DownlinkParser {
     pub fn push(&mut self, byte: u8) -> Option<Downlink> {
         // The fast path: a frame whose length is known is still incomplete after this byte;
         // nothing can be decided, so the byte is only stored.
-        if !self.drain {
-            if usize::from(self.pending) > self.buf.len().saturating_add(1) {
-                if self.buf.push(byte) {
-                    return None;
-                }
-            } else if self.pending == 0 {
-                // A frame's first two bytes: with the first, nothing can be decided; with the
-                // second, the header gives the length to wait for.
-                let first = match self.buf.as_slice() {
-                    [] => None,
-                    [first] => Some(*first),
-                    _ => Some(0),
-                };
-                match (self.buf.len(), first) {
-                    (0, _) if Kind::may_start(byte) && self.buf.push(byte) => return None,
-                    // A byte that starts no frame, with nothing before it: thrown away at once.
-                    (0, _) if !Kind::may_start(byte) => {
-                        self.discard();
+        if self.missing > 1 {
+            if self.buf.push(byte) {
+                self.missing = self.missing.saturating_sub(1);
+                return None;
+            }
+        } else if self.missing == 0 && !self.drain {
+            // A frame's first two bytes: with the first, nothing can be decided; with the
+            // second, the header gives the length to wait for.
+            match self.buf.as_slice() {
+                [] if Kind::may_start(byte) => {
+                    if self.buf.push(byte) {
                         return None;
                     }
-                    (1, Some(first)) => {
-                        if let Some(kind) = Kind::from_header(first, byte) {
-                            if self.buf.push(byte) {
-                                self.pending = u8::try_from(kind.len()).unwrap_or(0);
-                                return None;
-                            }
+                }
+                // A byte that starts no frame, with nothing before it: thrown away at once.
+                [] => {
+                    self.discard();
+                    return None;
+                }
+                &[first] => {
+                    if let Some(kind) = Kind::from_header(first, byte) {
+                        if self.buf.push(byte) {
+                            self.missing = u8::try_from(kind.len().saturating_sub(2)).unwrap_or(0);
+                            return None;
                         }
                     }
-                    _ => {}
                 }
+                _ => {}
             }
         }
         let ready = if self.drain { self.poll() } else { None };
@@ -444,12 +443,12 @@ impl DownlinkParser {
     }
 
     fn run(&mut self, quiet: bool) -> Option<Downlink> {
-        self.pending = 0;
+        self.missing = 0;
         loop {
             match self.judge(quiet) {
                 Verdict::NeedMore => {
                     self.drain = false;
-                    self.pending = self.front_len();
+                    self.missing = self.front_missing();
                     return None;
                 }
                 Verdict::Reject => self.reject(),
@@ -475,13 +474,13 @@ impl DownlinkParser {
         }
     }
 
-    /// The length of the frame whose header is at the front of the window, if it is not yet
-    /// complete (0 otherwise).
-    fn front_len(&self) -> u8 {
+    /// Bytes still missing from the frame whose header is at the front of the window (0 if
+    /// there is none, or it is complete).
+    fn front_missing(&self) -> u8 {
         match self.buf.as_slice() {
             [first, second, ..] => match Kind::from_header(*first, *second) {
-                Some(kind) if kind.len() > self.buf.len() => u8::try_from(kind.len()).unwrap_or(0),
-                _ => 0,
+                Some(kind) => u8::try_from(kind.len().saturating_sub(self.buf.len())).unwrap_or(0),
+                None => 0,
             },
             _ => 0,
         }
