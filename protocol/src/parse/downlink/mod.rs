@@ -295,15 +295,15 @@ impl DownlinkParser {
             // A frame's first two bytes: with the first, nothing can be decided; with the
             // second, the header gives the length to wait for.
             match self.buf.as_slice() {
-                [] if Kind::may_start(byte) => {
+                [] => {
+                    // A byte that starts no frame, with nothing before it: thrown away at once.
+                    if !Kind::may_start(byte) {
+                        self.discard();
+                        return None;
+                    }
                     if self.buf.push(byte) {
                         return None;
                     }
-                }
-                // A byte that starts no frame, with nothing before it: thrown away at once.
-                [] => {
-                    self.discard();
-                    return None;
                 }
                 &[first] => {
                     if let Some(kind) = Kind::from_header(first, byte) {
