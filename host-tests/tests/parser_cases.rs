@@ -195,7 +195,7 @@ fn case6_a_line_of_battery_frames_only() {
         })
         .collect();
     let line: Vec<u8> = frames.iter().flat_map(|b| b.encode()).collect();
-    // From a quiet line: every frame. Without one: every frame too, once three show the count
+    // From a quiet line: every frame. Without one: every frame too, once four show the count
     // moving in step.
     for start_quiet in [true, false] {
         let mut p = DownlinkParser::new();

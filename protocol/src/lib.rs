@@ -13,8 +13,10 @@
 //! let turn: [u8; 10] = Turn::by_deci_degrees(900).encode(); // once: the board adds it up
 //! assert_eq!(turn[9], 0b0001_0000);
 //!
-//! // Board → master: a byte stream in, typed frames out.
+//! // Board → master: a byte stream in, typed frames out. The line was quiet before (as it is
+//! // when the board powers up, and between its bursts): the next byte starts a frame.
 //! let mut parser = DownlinkParser::new();
+//! assert_eq!(parser.quiet(5), None);
 //! let mut wire = Vec::new();
 //! for seq in 0..3 {
 //!     wire.extend_from_slice(&Imu { accel: [0, 0, 16_384], gyro: [0, 0, -6], seq }.encode());

@@ -38,7 +38,7 @@
 //! | 10 | Hunting | the awaited reply | when the chain (or a quiet line) vouches |
 //! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it) |
 //! | 12 | Hunting | a reply nobody awaits | never |
-//! | 13 | Hunting | telemetry, count far | when its own stream's next two frames in the chain move on from it in step (the board restarted its counts) |
+//! | 13 | Hunting | telemetry, count far | when its own stream's next three frames in the chain move on from it in step (the board restarted its counts) |
 //!
 //! *The chain vouches* ([`rules::Chain`]) when the frames right after the candidate, back to
 //! back, reach one whose count continues (or is near) its stream's count, counting the
@@ -50,10 +50,10 @@
 //! payload can hold a header that ends where the line goes quiet). The chain is looked for
 //! within the window; a window full before it decides is a no.
 //!
-//! At start-up nothing is known: a stream's first frame found while hunting then needs two more
-//! frames of its stream in the chain, equally spaced by 1 to 4 counts
-//! ([`counts::FIRST_STEP_MAX`]): sensor bytes drift slowly, so two false frames' "counts" can
-//! be a few apart, but rarely three in step. A parser that starts listening anywhere emits
+//! At start-up nothing is known: a stream's first frame found while hunting then needs three
+//! more frames of its stream in the chain, equally spaced by 1 to 4 counts
+//! ([`counts::FIRST_STEP_MAX`]): sensor bytes drift slowly and payloads repeat a frame's length
+//! apart, so false frames' "counts" can move in small steps for a frame or two, rarely four. A parser that starts listening anywhere emits
 //! nothing until the line has shown it a count. From a quiet line on a clean line (a board
 //! powering up, a capture that starts in an idle stretch), every frame comes out.
 //!
@@ -90,6 +90,10 @@ pub const WINDOW: usize = 96;
 
 /// After this many bytes without a frame taken, the counts are forgotten.
 pub const FORGET_AFTER: u16 = 240;
+
+/// Frames of its own stream after a candidate, all the same number of counts apart, that vouch
+/// for it when no step has been learnt (start-up, a board that restarted its counts).
+const IN_STEP: u8 = 3;
 
 /// Junk bytes a candidate whose count continues exactly may have before its chain.
 const MAX_GAP: usize = 2;
@@ -608,7 +612,7 @@ impl DownlinkParser {
         } else {
             0
         };
-        let mut own_step = None;
+        let mut own_step: Option<(u8, u8)> = None;
         loop {
             // The next frame's header: right at `pos`, or (first link of an exactly continuing
             // candidate) after up to two junk bytes.
@@ -665,14 +669,19 @@ impl DownlinkParser {
                 let mut vouches = !own_only || own == Some(stream);
                 let in_step = chain == Chain::Restart || !counts.has_steps(stream);
                 if vouches && own_only && in_step {
-                    // No step learnt: sensor bytes drift slowly, so two false frames' "counts"
-                    // can be a few apart. Three frames of the stream, equally spaced, vouch.
+                    // No step learnt: sensor bytes drift slowly, and payloads repeat a frame's
+                    // length apart, so false frames' "counts" can move in small steps for a
+                    // while. Four frames of the stream, equally spaced, vouch.
                     let delta = seq.wrapping_sub(counts.last(stream));
                     match own_step {
-                        Some(step) if step == delta => {}
+                        Some((step, seen)) if step == delta && seen >= IN_STEP - 1 => {}
+                        Some((step, seen)) if step == delta => {
+                            own_step = Some((step, seen.saturating_add(1)));
+                            vouches = false;
+                        }
                         Some(_) => return Some(false),
                         None => {
-                            own_step = Some(delta);
+                            own_step = Some((delta, 1));
                             vouches = false;
                         }
                     }

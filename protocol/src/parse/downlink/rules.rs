@@ -50,7 +50,7 @@ pub enum Chain {
     /// (Tentative), a candidate that the next quiet line ends exactly (it is the whole burst)
     /// is vouched for too.
     Own,
-    /// As `Own`, but always two more frames of the stream, equally spaced: a far count found
+    /// As `Own`, but always three more frames of the stream, equally spaced: a far count found
     /// while hunting (the board restarted its counts) is taken only when the line shows the
     /// new count moving in step.
     Restart,
@@ -102,7 +102,7 @@ pub const fn need(lock: Lock, class: Class) -> Need {
         // 12. A reply nobody waits for, hunting: never (the tail of a damaged frame, `23` and a
         //     code in its payload, ends right where the next real frame starts).
         (Lock::Hunting, Class::Unexpected) => Need::Never,
-        // 13. Hunting, a far count: its own stream's next two frames must move on from it in
+        // 13. Hunting, a far count: its own stream's next three frames must move on from it in
         //     step (a board that restarted its counts).
         (Lock::Hunting, Class::Far) => Need::Chain(Chain::Restart),
     }

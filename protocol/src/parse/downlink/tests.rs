@@ -25,9 +25,10 @@ fn drain_quiet(p: &mut DownlinkParser, ms: u32) -> Vec<Downlink> {
     out
 }
 
-/// A parser locked on IMU frames 1..=3 (all emitted).
+/// A parser locked on IMU frames 1..=3 (all emitted), from a quiet line.
 fn locked() -> DownlinkParser {
     let mut p = DownlinkParser::new();
+    assert_eq!(p.quiet(1), None);
     let mut out = Vec::new();
     for seq in 1..=3 {
         out.extend(feed(&mut p, &imu(seq, 0).encode()));
@@ -45,18 +46,21 @@ fn locked_frames_come_out_on_their_last_byte() {
     let b = imu(2, 0).encode();
     let c = imu(3, 0).encode();
     let d = imu(4, 0).encode();
+    let e = imu(5, 0).encode();
     // Hunting with no count known, the first frame waits until the line has shown its count
-    // moving in step: two more IMU frames.
+    // moving in step: three more IMU frames.
     assert_eq!(feed(&mut p, &a), vec![]);
     assert_eq!(feed(&mut p, &b), vec![]);
-    assert_eq!(feed(&mut p, &c[..14]), vec![]);
-    assert_eq!(p.push(c[14]), Some(Downlink::Imu(imu(1, 0))));
-    assert_eq!(p.poll(), Some(Downlink::Imu(imu(2, 0))));
-    assert_eq!(p.poll(), Some(Downlink::Imu(imu(3, 0))));
+    assert_eq!(feed(&mut p, &c), vec![]);
+    assert_eq!(feed(&mut p, &d[..14]), vec![]);
+    assert_eq!(p.push(d[14]), Some(Downlink::Imu(imu(1, 0))));
+    for seq in 2..=4 {
+        assert_eq!(p.poll(), Some(Downlink::Imu(imu(seq, 0))));
+    }
     assert_eq!(p.lock(), Lock::Locked);
     // From now on, out on the last byte.
-    assert_eq!(feed(&mut p, &d[..14]), vec![]);
-    assert_eq!(p.push(d[14]), Some(Downlink::Imu(imu(4, 0))));
+    assert_eq!(feed(&mut p, &e[..14]), vec![]);
+    assert_eq!(p.push(e[14]), Some(Downlink::Imu(imu(5, 0))));
     assert_eq!(p.buffered(), 0);
     assert_eq!(p.stats().discarded, 0);
 }
@@ -82,7 +86,9 @@ fn a_reply_nobody_awaits_needs_the_next_count() {
 
 #[test]
 fn a_dropped_byte_loses_only_its_own_frame() {
+    // From a quiet line: the stream's first frames come out at once.
     let mut p = DownlinkParser::new();
+    assert_eq!(p.quiet(1), None);
     let mut stream = Vec::new();
     for seq in 0..6u8 {
         stream.extend_from_slice(&imu(seq, -4).encode());
@@ -214,7 +220,7 @@ fn never_stuck_on_any_single_byte_value() {
         }
         assert!(p.buffered() <= WINDOW);
         let mut stream = Vec::new();
-        for seq in 0..4u8 {
+        for seq in 0..5u8 {
             stream.extend_from_slice(&imu(seq, 0).encode());
         }
         let out = feed(&mut p, &stream);
