@@ -4,8 +4,19 @@
 //! that `decode` can return: reserved bits and negative zeros are where `decode` puts them, and
 //! a setting that fits a typed form is never `Setting::Raw`. Hence encode → decode is exact.
 
-use crate::{Battery, Command, Downlink, Encoders, Imu, Motors, Reply, Setting, Turn, Velocity};
+use crate::command::motion::{dir::ANGLE_MODE, field::VELOCITY_DIR};
+use crate::command::{HEADER, mode, settings};
+use crate::{
+    Battery, Command, Downlink, Encoders, Imu, Motors, Register, Reply, Setting, Turn, Velocity,
+};
 use arbitrary::{Arbitrary, Result, Unstructured};
+
+/// A master → board frame's first three bytes: the header and `mode` (from the frame modules'
+/// own constants).
+const fn head(mode: u8) -> [u8; 3] {
+    let [a, b] = HEADER;
+    [a, b, mode]
+}
 
 /// `N` bytes: `head`, then arbitrary bytes, then `fix` applied.
 fn layout<const N: usize>(
@@ -27,12 +38,9 @@ fn ok<T>(decoded: core::result::Result<T, crate::Error>) -> Result<T> {
 }
 
 /// Direction byte of a mode-`0x01` frame, and its angle-mode bit.
-const VELOCITY_DIR: usize = 9;
-const ANGLE_MODE: u8 = 1 << 4;
-
 impl<'a> Arbitrary<'a> for Velocity {
     fn arbitrary(u: &mut Unstructured<'a>) -> Result<Self> {
-        let bytes = layout::<{ Velocity::LEN }>(u, &[0xFF, 0xFE, 0x01], |b| {
+        let bytes = layout::<{ Velocity::LEN }>(u, &head(mode::VELOCITY), |b| {
             if let Some(d) = b.get_mut(VELOCITY_DIR) {
                 *d &= !ANGLE_MODE;
             }
@@ -43,7 +51,7 @@ impl<'a> Arbitrary<'a> for Velocity {
 
 impl<'a> Arbitrary<'a> for Turn {
     fn arbitrary(u: &mut Unstructured<'a>) -> Result<Self> {
-        let bytes = layout::<{ Turn::LEN }>(u, &[0xFF, 0xFE, 0x01], |b| {
+        let bytes = layout::<{ Turn::LEN }>(u, &head(mode::VELOCITY), |b| {
             if let Some(d) = b.get_mut(VELOCITY_DIR) {
                 *d |= ANGLE_MODE;
             }
@@ -54,26 +62,32 @@ impl<'a> Arbitrary<'a> for Turn {
 
 impl<'a> Arbitrary<'a> for Motors {
     fn arbitrary(u: &mut Unstructured<'a>) -> Result<Self> {
-        let mode = if u.arbitrary()? { 0x02 } else { 0x03 };
-        let bytes = layout::<{ Motors::LEN }>(u, &[0xFF, 0xFE, mode], |_| {})?;
+        let mode = if u.arbitrary()? {
+            mode::MOTORS_CLOSED_LOOP
+        } else {
+            mode::MOTORS_OPEN_LOOP
+        };
+        let bytes = layout::<{ Motors::LEN }>(u, &head(mode), |_| {})?;
         ok(Motors::decode(&bytes))
     }
 }
 
 impl<'a> Arbitrary<'a> for Setting {
     fn arbitrary(u: &mut Unstructured<'a>) -> Result<Self> {
-        // Mostly typed settings: codes the spec defines, reserved byte 9 at 0.
-        const CODES: [u8; 18] = [
-            0x00, 0x01, 0x06, 0x07, 0x08, 0x09, 0x0A, 0x0B, 0x0C, 0x11, 0x16, 0x17, 0x18, 0x19,
-            0x1A, 0x1B, 0x1C, 0x20,
-        ];
+        // Mostly typed settings: codes the spec defines (the actions', each register's write
+        // and read codes, from the register table), reserved byte 9 at 0.
         let code = if u.ratio(7u8, 8)? {
-            *u.choose(&CODES)?
+            match u.int_in_range(0u8..=2)? {
+                0 => settings::ACTION_CODE,
+                1 => u.choose(&Register::ALL)?.code(),
+                _ => u.choose(&Register::ALL)?.read_code(),
+            }
         } else {
             u.arbitrary()?
         };
         let tail = if u.ratio(7u8, 8)? { 0 } else { u.arbitrary()? };
-        let bytes = layout::<{ Setting::LEN }>(u, &[0xFF, 0xFE, 0x80, 0x80, code], |b| {
+        let [a, b, m] = head(mode::SETTINGS);
+        let bytes = layout::<{ Setting::LEN }>(u, &[a, b, m, settings::FIXED, code], |b| {
             if let Some(t) = b.last_mut() {
                 *t = tail;
             }

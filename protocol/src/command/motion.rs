@@ -31,7 +31,7 @@ use crate::error::Error;
 use crate::wire;
 
 /// Byte offsets of the motion frames.
-mod field {
+pub(crate) mod field {
     pub const HEADER: usize = 0;
     pub const MODE: usize = 2;
     pub const X: usize = 3;
@@ -44,7 +44,7 @@ mod field {
 }
 
 /// Bits of the direction bytes.
-mod dir {
+pub(crate) mod dir {
     pub const Z_REVERSE: u8 = 1 << 0;
     pub const Y_REVERSE: u8 = 1 << 1;
     pub const X_REVERSE: u8 = 1 << 2;

@@ -33,9 +33,11 @@ mod field {
 }
 
 /// The byte after the settings mode byte.
-const FIXED: u8 = 0x80;
+pub(crate) const FIXED: u8 = 0x80;
+/// Where it stands (the master → board parser checks it early).
+pub(crate) const FIXED_AT: usize = field::FIXED;
 /// Code of the actions (2A).
-const ACTION_CODE: u8 = 0x00;
+pub(crate) const ACTION_CODE: u8 = 0x00;
 /// Bytes 5–6 of an action: `80 00`.
 const ACTION_MARK: u32 = 0x8000_0000;
 

@@ -26,7 +26,7 @@ use super::window::Window;
 use crate::command::{self, Command, HEADER};
 
 /// Byte 3 of a settings frame.
-const SETTINGS_FIXED_AT: usize = 3;
+use crate::command::settings::{FIXED as SETTINGS_FIXED, FIXED_AT as SETTINGS_FIXED_AT};
 
 /// The master → board streaming parser.
 ///
@@ -138,16 +138,18 @@ impl UplinkParser {
 
     fn bytes_before_decision(&self) -> usize {
         match self.window.as_slice() {
-            [0xFF, 0xFE, mode, ..] => match command::frame_len(*mode) {
-                // Stop at byte 3 of a settings frame to check it early.
-                Some(len) if self.window.len() <= SETTINGS_FIXED_AT => SETTINGS_FIXED_AT
-                    .saturating_add(1)
-                    .min(len)
-                    .saturating_sub(self.window.len())
-                    .max(1),
-                Some(len) => len.saturating_sub(self.window.len()).max(1),
-                None => 1,
-            },
+            [first, second, mode, ..] if [*first, *second] == HEADER => {
+                match command::frame_len(*mode) {
+                    // Stop at byte 3 of a settings frame to check it early.
+                    Some(len) if self.window.len() <= SETTINGS_FIXED_AT => SETTINGS_FIXED_AT
+                        .saturating_add(1)
+                        .min(len)
+                        .saturating_sub(self.window.len())
+                        .max(1),
+                    Some(len) => len.saturating_sub(self.window.len()).max(1),
+                    None => 1,
+                }
+            }
             _ => 1,
         }
     }
@@ -188,7 +190,9 @@ impl UplinkParser {
         let Some(len) = command::frame_len(mode) else {
             return Verdict::Reject;
         };
-        if mode == 0x80 && matches!(buf.get(SETTINGS_FIXED_AT), Some(b) if *b != 0x80) {
+        if mode == command::mode::SETTINGS
+            && matches!(buf.get(SETTINGS_FIXED_AT), Some(b) if *b != SETTINGS_FIXED)
+        {
             return Verdict::Reject;
         }
         let Some(bytes) = buf.get(..len) else {

@@ -95,11 +95,12 @@ impl Kind {
     /// `23` is an ordinary byte in payloads.
     #[must_use]
     pub const fn from_header(first: u8, second: u8) -> Option<Kind> {
-        match (first, second) {
-            (0xFF, 0xFA) => Some(Kind::Telemetry(Stream::Imu)),
-            (0xFF, 0xFB) => Some(Kind::Telemetry(Stream::Encoders)),
-            (0xFF, 0xFC) => Some(Kind::Telemetry(Stream::Battery)),
-            (Reply::HEADER, code) if Register::from_reply_code(code).is_some() => Some(Kind::Reply),
+        // The headers are the frame modules' own constants: written once.
+        match [first, second] {
+            Imu::HEADER => Some(Kind::Telemetry(Stream::Imu)),
+            Encoders::HEADER => Some(Kind::Telemetry(Stream::Encoders)),
+            Battery::HEADER => Some(Kind::Telemetry(Stream::Battery)),
+            [Reply::HEADER, code] if Register::from_reply_code(code).is_some() => Some(Kind::Reply),
             _ => None,
         }
     }
@@ -107,7 +108,8 @@ impl Kind {
     /// Whether `first` can start a frame (`FF` or `23`).
     #[must_use]
     pub const fn may_start(first: u8) -> bool {
-        first == 0xFF || first == Reply::HEADER
+        let [sync, _] = Imu::HEADER;
+        first == sync || first == Reply::HEADER
     }
 
     /// The frame's length on the wire.
@@ -182,11 +184,16 @@ impl Downlink {
     /// unknown code decodes (it is kept, not rejected).
     pub fn decode(bytes: &[u8]) -> Result<Self, Error> {
         match bytes {
-            [0xFF, 0xFA, ..] => Imu::decode(bytes).map(Downlink::Imu),
-            [0xFF, 0xFB, ..] => Encoders::decode(bytes).map(Downlink::Encoders),
-            [0xFF, 0xFC, ..] => Battery::decode(bytes).map(Downlink::Battery),
-            [Reply::HEADER, ..] => Reply::decode(bytes).map(Downlink::Reply),
-            [] | [0xFF] => Err(Error::Length),
+            [first, second, ..] => match [*first, *second] {
+                Imu::HEADER => Imu::decode(bytes).map(Downlink::Imu),
+                Encoders::HEADER => Encoders::decode(bytes).map(Downlink::Encoders),
+                Battery::HEADER => Battery::decode(bytes).map(Downlink::Battery),
+                [Reply::HEADER, _] => Reply::decode(bytes).map(Downlink::Reply),
+                _ => Err(Error::Header),
+            },
+            [Reply::HEADER] => Reply::decode(bytes).map(Downlink::Reply),
+            [first] if Kind::may_start(*first) => Err(Error::Length),
+            [] => Err(Error::Length),
             _ => Err(Error::Header),
         }
     }

@@ -793,7 +793,9 @@ fn followed(buf: &[u8], len: usize, quiet: bool) -> Option<bool> {
 /// Whether `bytes` hold a telemetry header (a reply's value that might be a cut reply with the
 /// next frame's start in it).
 fn holds_a_frame_start(bytes: &[u8]) -> bool {
-    bytes.windows(2).any(|w| matches!(w, [0xFF, 0xFA..=0xFC]))
+    bytes.windows(2).any(
+        |w| matches!(w, [a, b] if matches!(Kind::from_header(*a, *b), Some(Kind::Telemetry(_)))),
+    )
 }
 
 /// The frames in a slice, from [`DownlinkParser::frames`].
