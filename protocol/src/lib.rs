@@ -83,6 +83,7 @@
 #[cfg(feature = "arbitrary")]
 mod arbitrary;
 mod bytes;
+mod codes;
 pub mod command;
 #[cfg(feature = "driver")]
 pub mod driver;

@@ -16,6 +16,7 @@
 //! non-zero reserved byte) decodes as [`Setting::Raw`] and re-encodes to the same bytes.
 
 use super::{HEADER, SystemMode, mode};
+use crate::codes::code_enum;
 use crate::error::Error;
 use crate::wire;
 
@@ -41,63 +42,38 @@ pub(crate) const ACTION_CODE: u8 = 0x00;
 /// Bytes 5–6 of an action: `80 00`.
 const ACTION_MARK: u32 = 0x8000_0000;
 
-/// A register of the board: what a [`Write`] sets, a [`Setting::Read`] asks for and a
-/// [`Reply`](crate::Reply) answers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub enum Register {
-    /// `0x01`: maximum speed limit, u16 (unit not stated, A8).
-    MaxSpeed,
-    /// `0x06`: speed-loop KP, raw u32.
-    SpeedKp,
-    /// `0x07`: speed-loop KI, raw u32.
-    SpeedKi,
-    /// `0x08`: gyro compensation gain, u32 in 0.00001 (too large makes the chassis oscillate).
-    GyroGain,
-    /// `0x09`: the [`SystemMode`] bit field.
-    SystemMode,
-    /// `0x0A`: gyro calibration value, u16; writing 0xFFFF calibrates again.
-    GyroCalibration,
-    /// `0x0B`: motor output voltage, u16 in 0.01 V.
-    MotorVoltage,
-    /// `0x0C`: battery voltage range: full (high u16) and cut-off (low u16), 0.01 V;
-    /// 0x7FFF = the built-in table.
-    BatteryRange,
-    /// `0x20` (read only, 2D): the rotation still to turn, i32 in 0.1°.
-    PendingAngle,
+code_enum! {
+    /// A register of the board: what a [`Write`] sets, a [`Setting::Read`] asks for and a
+    /// [`Reply`](crate::Reply) answers. [`Register::code`] is its write code and the code its
+    /// reply carries.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+    #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+    pub enum Register (code, from_code): u8 {
+        /// `0x01`: maximum speed limit, u16 (unit not stated, A8).
+        MaxSpeed = 0x01,
+        /// `0x06`: speed-loop KP, raw u32.
+        SpeedKp = 0x06,
+        /// `0x07`: speed-loop KI, raw u32.
+        SpeedKi = 0x07,
+        /// `0x08`: gyro compensation gain, u32 in 0.00001 (too large makes the chassis
+        /// oscillate).
+        GyroGain = 0x08,
+        /// `0x09`: the [`SystemMode`] bit field.
+        SystemMode = 0x09,
+        /// `0x0A`: gyro calibration value, u16; writing 0xFFFF calibrates again.
+        GyroCalibration = 0x0A,
+        /// `0x0B`: motor output voltage, u16 in 0.01 V.
+        MotorVoltage = 0x0B,
+        /// `0x0C`: battery voltage range: full (high u16) and cut-off (low u16), 0.01 V;
+        /// 0x7FFF = the built-in table.
+        BatteryRange = 0x0C,
+        /// `0x20` (read only, 2D): the rotation still to turn, i32 in 0.1°.
+        PendingAngle = 0x20,
+    }
 }
 
 impl Register {
-    /// Every register, in code order.
-    pub const ALL: [Register; 9] = [
-        Register::MaxSpeed,
-        Register::SpeedKp,
-        Register::SpeedKi,
-        Register::GyroGain,
-        Register::SystemMode,
-        Register::GyroCalibration,
-        Register::MotorVoltage,
-        Register::BatteryRange,
-        Register::PendingAngle,
-    ];
-
-    /// The register's code: its write code, and the code its reply carries.
-    #[must_use]
-    pub const fn code(self) -> u8 {
-        match self {
-            Register::MaxSpeed => 0x01,
-            Register::SpeedKp => 0x06,
-            Register::SpeedKi => 0x07,
-            Register::GyroGain => 0x08,
-            Register::SystemMode => 0x09,
-            Register::GyroCalibration => 0x0A,
-            Register::MotorVoltage => 0x0B,
-            Register::BatteryRange => 0x0C,
-            Register::PendingAngle => 0x20,
-        }
-    }
-
     /// The code that reads it: `0x10 +` its code (2C), `0x20` for the pending angle (2D).
     #[must_use]
     pub const fn read_code(self) -> u8 {
@@ -116,18 +92,7 @@ impl Register {
     /// The register whose reply carries `code`.
     #[must_use]
     pub const fn from_reply_code(code: u8) -> Option<Self> {
-        match code {
-            0x01 => Some(Register::MaxSpeed),
-            0x06 => Some(Register::SpeedKp),
-            0x07 => Some(Register::SpeedKi),
-            0x08 => Some(Register::GyroGain),
-            0x09 => Some(Register::SystemMode),
-            0x0A => Some(Register::GyroCalibration),
-            0x0B => Some(Register::MotorVoltage),
-            0x0C => Some(Register::BatteryRange),
-            0x20 => Some(Register::PendingAngle),
-            _ => None,
-        }
+        Register::from_code(code)
     }
 
     /// The register that `code` reads.
@@ -144,56 +109,29 @@ impl Register {
     }
 }
 
-/// A 2A action: code `00`, bytes 5–6 `80 00`, bytes 7–8 the action.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub enum Action {
-    /// `0x0001`: load the stored settings.
-    LoadStored,
-    /// `0x0002`: load the factory defaults.
-    LoadDefaults,
-    /// `0x0003`: store the current settings (system-mode bit 3 is not stored).
-    Store,
-    /// `0x0004`: gyro compensation off (system-mode bit 3 = 0; A4).
-    GyroCompensationOff,
-    /// `0x0005`: gyro compensation on (system-mode bit 3 = 1; A4).
-    GyroCompensationOn,
-    /// `0x0006`: calibrate the gyro again, compensation on. Takes 30 s: 10 s to put the
-    /// chassis in place, then 20 s without moving or touching it.
-    RecalibrateGyro,
+code_enum! {
+    /// A 2A action: code `00`, bytes 5–6 `80 00`, bytes 7–8 the action number
+    /// ([`Action::number`]).
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+    #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+    pub enum Action (number, from_number): u16 {
+        /// `0x0001`: load the stored settings.
+        LoadStored = 1,
+        /// `0x0002`: load the factory defaults.
+        LoadDefaults = 2,
+        /// `0x0003`: store the current settings (system-mode bit 3 is not stored).
+        Store = 3,
+        /// `0x0004`: gyro compensation off (system-mode bit 3 = 0; A4).
+        GyroCompensationOff = 4,
+        /// `0x0005`: gyro compensation on (system-mode bit 3 = 1; A4).
+        GyroCompensationOn = 5,
+        /// `0x0006`: calibrate the gyro again, compensation on. Takes 30 s: 10 s to put the
+        /// chassis in place, then 20 s without moving or touching it.
+        RecalibrateGyro = 6,
+    }
     /// Any other action number, kept as received.
-    Unknown(u16),
-}
-
-impl Action {
-    /// The action number (bytes 7–8).
-    #[must_use]
-    pub const fn number(self) -> u16 {
-        match self {
-            Action::LoadStored => 1,
-            Action::LoadDefaults => 2,
-            Action::Store => 3,
-            Action::GyroCompensationOff => 4,
-            Action::GyroCompensationOn => 5,
-            Action::RecalibrateGyro => 6,
-            Action::Unknown(n) => n,
-        }
-    }
-
-    /// The action of number `n`.
-    #[must_use]
-    pub const fn from_number(n: u16) -> Self {
-        match n {
-            1 => Action::LoadStored,
-            2 => Action::LoadDefaults,
-            3 => Action::Store,
-            4 => Action::GyroCompensationOff,
-            5 => Action::GyroCompensationOn,
-            6 => Action::RecalibrateGyro,
-            other => Action::Unknown(other),
-        }
-    }
+    unknown Unknown
 }
 
 /// A 2B register write.
