@@ -131,7 +131,7 @@ pub struct Config {
     /// After a settings frame the board pauses its telemetry (A13: at least up to 500 ms); the
     /// failsafe allows it this long to speak again.
     pub settings_pause_ms: u32,
-    /// A line quiet for this long marks a frame boundary ([`crate::DownlinkParser::idle`]). It
+    /// A line quiet for this long marks a frame boundary ([`crate::DownlinkParser::quiet`]). It
     /// must be longer than any gap *inside* a frame: 2 ms on a UART peripheral, more behind a
     /// USB-UART adapter, which delivers bytes in bursts.
     pub idle_ms: u32,
