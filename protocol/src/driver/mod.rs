@@ -29,7 +29,7 @@
 //! While the driver has the chassis moving, it sends STOP once no frame from the board
 //! (telemetry or reply) has been read for [`Config::failsafe_ms`] (100 ms), or, after a settings
 //! frame, for [`Config::settings_pause_ms`] (600 ms: the board pauses telemetry while settings
-//! are made, A13). It is judged only after every byte the UART holds has been read, so a loop
+//! are made, A13) until its telemetry is back. It is judged only after every byte the UART holds has been read, so a loop
 //! slower than the limit is never stopped by its own slowness; such a loop stops a silent board
 //! at its first poll that reads nothing.
 //!
@@ -274,6 +274,16 @@ impl<E> Error<E> {
         match self {
             Error::Core(e) => Some(*e),
             _ => None,
+        }
+    }
+
+    /// The same error with the transport's error mapped by `f`: e.g. to its
+    /// `embedded_io::ErrorKind`, so that code shared by several HALs sees one error type.
+    pub fn map_transport<F>(self, f: impl FnOnce(E) -> F) -> Error<F> {
+        match self {
+            Error::Transport(e) => Error::Transport(f(e)),
+            Error::WriteZero => Error::WriteZero,
+            Error::Core(e) => Error::Core(e),
         }
     }
 }

@@ -19,7 +19,8 @@
 //! While the driver has the chassis moving, it sends STOP when it has heard **no frame** from
 //! the board (telemetry or reply) for [`Config::failsafe_ms`] (100 ms), except that after a
 //! settings frame the board may stay silent for [`Config::settings_pause_ms`] (600 ms), since it
-//! pauses telemetry while settings are made (A13: up to at least 500 ms).
+//! pauses telemetry while settings are made (A13: up to at least 500 ms), until its telemetry
+//! comes back (the pause is then over: from there on, 100 ms of silence is a dead link).
 //!
 //! It is judged on the input already read: a shell calls [`DriverCore::tick`] only after taking
 //! in every byte the UART holds, so a slow loop never mistakes its own slowness for a dead link.
@@ -83,11 +84,15 @@ impl StreamInfo {
         self.window_frames = self.window_frames.saturating_add(1);
         let span = at_ms.saturating_sub(start);
         if span >= Self::WINDOW_MS {
-            let rate = u64::from(self.window_frames)
+            // In 32 bits (a Cortex-M divides those in hardware; 64-bit division is a library
+            // routine): a window closes at its first frame after a second, so it never holds
+            // the 4 295 frames that would saturate.
+            let span = u32::try_from(span).unwrap_or(u32::MAX);
+            self.rate_millihertz = self
+                .window_frames
                 .saturating_mul(1_000_000)
                 .checked_div(span)
                 .unwrap_or(0);
-            self.rate_millihertz = u32::try_from(rate).unwrap_or(u32::MAX);
             self.window_start_ms = Some(at_ms);
             self.window_frames = 0;
         }
@@ -304,6 +309,8 @@ pub struct DriverCore {
     quiet_reported_ms: Option<u64>,
     /// The last settings frame sent: the board may pause its telemetry after it.
     settings_sent_ms: Option<u64>,
+    /// Telemetry frames heard since the last settings frame (saturating at 255).
+    telemetry_after_settings: u8,
     moving_since_ms: Option<u64>,
     turning: bool,
     /// The angle of the outstanding turn, in 0.1°.
@@ -347,6 +354,7 @@ impl DriverCore {
             last_byte_ms: None,
             quiet_reported_ms: None,
             settings_sent_ms: None,
+            telemetry_after_settings: 0,
             moving_since_ms: None,
             turning: false,
             turn_deci_degrees: 0,
@@ -568,6 +576,7 @@ impl DriverCore {
     /// [`transmit`](Self::transmit)). Call it once every byte the UART holds has gone through
     /// [`receive`](Self::receive).
     pub fn tick(&mut self, now_ms: u64) -> Option<Event> {
+        let mut event = None;
         if let Some(last) = self.last_byte_ms {
             if now_ms.saturating_sub(last) >= u64::from(self.config.idle_ms) {
                 // Report each stretch of quiet once: the time since the last byte, or since the
@@ -576,17 +585,21 @@ impl DriverCore {
                 let ms = u32::try_from(now_ms.saturating_sub(from)).unwrap_or(u32::MAX);
                 self.quiet_reported_ms = Some(now_ms);
                 if let Some(frame) = self.parser.quiet(ms) {
-                    return Some(self.frame(frame, now_ms));
+                    // Judged now, but heard when its last byte came: the failsafe counts
+                    // silence from there.
+                    event = Some(self.frame(frame, last));
                 }
             }
         }
+        // A frame the quiet let out is taken in first (it may be the awaited reply); time is
+        // judged either way, so frames held in the parser never delay the failsafe.
         self.check_reply_timeout(now_ms);
         if self.failsafe_due(now_ms) {
             self.moving_since_ms = None;
             self.stop_queued = true;
             self.failsafe_stops = self.failsafe_stops.wrapping_add(1);
         }
-        None
+        event
     }
 
     /// The next time [`tick`](Self::tick) may have something to do (a reply deadline, the
@@ -690,6 +703,7 @@ impl DriverCore {
 
     fn settings_sent(&mut self, now_ms: u64) {
         self.settings_sent_ms = Some(now_ms);
+        self.telemetry_after_settings = 0;
     }
 
     /// When the failsafe falls due, if the chassis is moving.
@@ -697,9 +711,15 @@ impl DriverCore {
         let since = self.moving_since_ms?;
         let heard = self.last_heard_ms.map_or(since, |t| t.max(since));
         let silent_until = heard.saturating_add(u64::from(self.config.failsafe_ms));
-        let paused_until = self.settings_sent_ms.map_or(0, |t| {
-            t.saturating_add(u64::from(self.config.settings_pause_ms))
-        });
+        // The pause allowance lasts until telemetry is heard again: once the board streams
+        // after the settings frame, its pause is over, and silence is silence. Two frames, not
+        // one: a frame the board sent just before the pause can come out of the parser after
+        // the settings frame went (confirmed by the reply's first byte).
+        let paused_until = match self.settings_sent_ms {
+            Some(_) if self.telemetry_after_settings >= 2 => 0,
+            Some(sent) => sent.saturating_add(u64::from(self.config.settings_pause_ms)),
+            None => 0,
+        };
         Some(silent_until.max(paused_until))
     }
 
@@ -908,6 +928,9 @@ impl DriverCore {
             Downlink::Reply(reply) => return self.reply(reply),
         };
         self.last_telemetry_ms = Some(now_ms);
+        if self.settings_sent_ms.is_some_and(|sent| now_ms > sent) {
+            self.telemetry_after_settings = self.telemetry_after_settings.saturating_add(1);
+        }
         let missed = self.parser.stats().missed_of(stream);
         if let Some(info) = self.streams.get_mut(stream.index()) {
             info.arrived(now_ms, missed);
@@ -1045,6 +1068,45 @@ mod tests {
         assert_eq!(core.transmit(1_599), None);
         let _ = core.tick(1_601);
         assert!(core.transmit(1_601).is_some());
+        // Standing still, silence is no reason to stop.
+        let _ = core.velocity(Velocity::STOP, 2_000);
+        let _ = core.tick(10_000);
+        assert_eq!(core.transmit(10_000), None);
+    }
+
+    #[test]
+    fn the_settings_pause_ends_when_telemetry_comes_back() {
+        // Found by the emulator test of the bring-up: a read just before a motion gave a board
+        // that went silent mid-motion 600 ms instead of 100.
+        let mut core = DriverCore::new(Config::DEFAULT);
+        let _ = core.velocity(Velocity::new(0, 100, 0), 0);
+        let _ = core.write(Write::MaxSpeed(10), 0);
+        let imu = crate::Imu {
+            accel: [0; 3],
+            gyro: [0; 3],
+            seq: 1,
+        };
+        for (i, at) in (150..=180).step_by(10).enumerate() {
+            let frame = crate::Imu {
+                seq: imu.seq.wrapping_add(i as u8),
+                ..imu
+            }
+            .encode();
+            let mut rest = &frame[..];
+            while !rest.is_empty() {
+                rest = core.receive(rest, at).1;
+            }
+            let _ = core.tick(at);
+        }
+        assert!(core.last_telemetry_ms().is_some(), "telemetry is back");
+        // Silent from 180: stopped after 100 ms, not 600 after the write.
+        let _ = core.tick(280);
+        assert_eq!(core.transmit(280), None);
+        let _ = core.tick(281);
+        assert_eq!(
+            core.transmit(281).map(|f| f.as_slice().to_vec()),
+            Some(Velocity::STOP.encode().to_vec())
+        );
         // Standing still, silence is no reason to stop.
         let _ = core.velocity(Velocity::STOP, 2_000);
         let _ = core.tick(10_000);

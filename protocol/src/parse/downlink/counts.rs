@@ -142,15 +142,19 @@ impl Counts {
         if delta == 0 {
             return Rel::Far;
         }
-        let steps = self.steps.get(i).copied().unwrap_or_default();
-        let learnt = steps.iter().filter(|s| s.hits > 0);
+        let Some(steps) = self.steps.get(i) else {
+            return Rel::Far;
+        };
         let mut any = false;
-        for step in learnt.clone() {
-            any = true;
-            if step.delta == delta {
-                return Rel::Continues;
+        for step in steps {
+            if step.hits > 0 {
+                if step.delta == delta {
+                    return Rel::Continues;
+                }
+                any = true;
             }
         }
+        let learnt = steps.iter().filter(|s| s.hits > 0);
         if !any && delta <= FIRST_STEP_MAX {
             return Rel::Continues;
         }
@@ -191,7 +195,8 @@ impl Counts {
     pub fn take(&mut self, stream: Stream, count: u8, learn: bool) {
         let i = stream.index();
         let bit = 1u8 << i;
-        let rebased = self.continues_alt(stream, count);
+        // (Most frames have no far count pending: skip the check then.)
+        let rebased = matches!(self.alt.get(i), Some(Some(_))) && self.continues_alt(stream, count);
         if let Some(alt) = self.alt.get_mut(i) {
             *alt = None;
         }

@@ -202,8 +202,9 @@ impl Buf {
 
 /// What the bytes in the window say about the candidate at its front.
 enum Verdict {
-    /// Not enough bytes to decide.
-    NeedMore,
+    /// Not enough bytes to decide: at least this many more (1 or more) before a decision can
+    /// fall (a quiet line aside).
+    NeedMore(usize),
     /// The first byte starts no frame: drop it.
     Reject,
     /// A frame of this length, and what it was judged to be.
@@ -288,12 +289,25 @@ impl DownlinkParser {
     /// [`poll`](Self::poll) or [`quiet`](Self::quiet)), never lost.
     #[inline]
     pub fn push(&mut self, byte: u8) -> Option<Downlink> {
-        // The fast path: a frame whose length is known is still incomplete after this byte;
-        // nothing can be decided, so the byte is only stored.
+        // The fast path, small enough to inline into the caller's loop: the last judgement
+        // needs more bytes than this one (a frame, or a frame of the chain after it, is still
+        // incomplete); nothing can be decided, so the byte is only stored.
+        if self.missing > 1 && self.buf.push(byte) {
+            self.missing = self.missing.saturating_sub(1);
+            return None;
+        }
+        self.push_slow(byte)
+    }
+
+    /// [`push`](Self::push) when a decision may fall.
+    #[inline(never)]
+    fn push_slow(&mut self, byte: u8) -> Option<Downlink> {
         if self.missing > 1 {
+            // The window's end is full: the general path makes room.
+        } else if self.missing == 1 && !self.drain {
+            // This byte completes the frame at the front of the window.
             if self.buf.push(byte) {
-                self.missing = self.missing.saturating_sub(1);
-                return None;
+                return self.complete();
             }
         } else if self.missing == 0 && !self.drain {
             // A frame's first two bytes: with the first, nothing can be decided; with the
@@ -357,13 +371,16 @@ impl DownlinkParser {
                 ([a], [b, ..]) => {
                     Kind::from_header(*a, *b).map_or(1, |kind| kind.len().saturating_sub(1))
                 }
-                _ => self.bytes_before_decision(),
+                // What the last judgement said it needs before anything can be decided.
+                _ => usize::from(self.missing),
             };
             let step = step.max(1).min(bytes.len());
             let (now, later) = bytes.split_at_checked(step).unwrap_or((bytes, &[]));
             self.append(now);
             bytes = later;
-            if let Some(frame) = self.poll() {
+            // `complete` takes a frame alone in the window on its own when it can, else it
+            // judges as `poll` does.
+            if let Some(frame) = self.complete() {
                 return (Some(frame), bytes);
             }
         }
@@ -376,6 +393,42 @@ impl DownlinkParser {
             parser: self,
             rest: bytes,
         }
+    }
+
+    /// The bytes just stored may have completed the frame at the front of the window: if it is
+    /// alone there and the rules take it at once (rows 1 and 2: its count continues, or it is
+    /// the awaited reply), it is taken without going through the general judgement; otherwise
+    /// the general judgement runs. The same decision either way: a shortcut, not a rule.
+    fn complete(&mut self) -> Option<Downlink> {
+        let bytes = self.buf.as_slice();
+        if let [first, second, ..] = *bytes {
+            if let Some(kind) = Kind::from_header(first, second) {
+                if kind.len() == bytes.len() {
+                    if let Ok(frame) = Downlink::decode(bytes) {
+                        // Row 1, the common case, without the general bookkeeping.
+                        if let (Kind::Telemetry(stream), Some(seq)) = (kind, frame.seq()) {
+                            if self.lock != Lock::Hunting
+                                && rules::need(self.lock, Class::Continues) == Need::Now
+                                && self.counts.rel(stream, seq, 0) == Rel::Continues
+                            {
+                                self.missing = 0;
+                                self.take_continuing(stream, seq, kind.len());
+                                self.drain = false;
+                                return Some(frame);
+                            }
+                        }
+                        let class = self.class(&frame, 0);
+                        if rules::need(self.lock, class) == Need::Now {
+                            self.missing = 0;
+                            self.accept(&frame, kind.len(), class);
+                            self.drain = false;
+                            return Some(frame);
+                        }
+                    }
+                }
+            }
+        }
+        self.poll()
     }
 
     /// Emits a frame that is already decided in the window, if any, without a new byte.
@@ -414,6 +467,9 @@ impl DownlinkParser {
     /// forgotten once its reply comes.
     pub fn expect_reply(&mut self, register: Option<Register>) {
         self.expect = register.map(Register::reply_code);
+        // A candidate waiting in the window may be judged differently now: judge it at the
+        // next byte, not only once the bytes it was waiting for are in.
+        self.missing = self.missing.min(self.front_missing());
     }
 
     /// How sure the parser is of where frames start.
@@ -450,9 +506,15 @@ impl DownlinkParser {
         self.missing = 0;
         loop {
             match self.judge(quiet) {
-                Verdict::NeedMore => {
+                Verdict::NeedMore(n) => {
                     self.drain = false;
-                    self.missing = self.front_missing();
+                    // Only a wait of two bytes or more is worth the shortcut: with one, the
+                    // next byte is judged anyway (and a lone junk byte is dropped at once).
+                    self.missing = if n > 1 {
+                        u8::try_from(n).unwrap_or(u8::MAX)
+                    } else {
+                        0
+                    };
                     return None;
                 }
                 Verdict::Reject => self.reject(),
@@ -487,18 +549,6 @@ impl DownlinkParser {
                 None => 0,
             },
             _ => 0,
-        }
-    }
-
-    /// How many bytes can be added before a decision can fall: the rest of a frame whose
-    /// header is in the window, else 1.
-    fn bytes_before_decision(&self) -> usize {
-        match self.buf.as_slice() {
-            [first, second, ..] => match Kind::from_header(*first, *second) {
-                Some(kind) => kind.len().saturating_sub(self.buf.len()).max(1),
-                None => 1,
-            },
-            _ => 1,
         }
     }
 
@@ -540,8 +590,8 @@ impl DownlinkParser {
     fn judge(&self, quiet: bool) -> Verdict {
         let buf = self.buf.as_slice();
         let (first, second) = match buf {
-            [] => return Verdict::NeedMore,
-            [first] if Kind::may_start(*first) && !quiet => return Verdict::NeedMore,
+            [] => return Verdict::NeedMore(1),
+            [first] if Kind::may_start(*first) && !quiet => return Verdict::NeedMore(1),
             [_] => return Verdict::Reject,
             [first, second, ..] => (*first, *second),
         };
@@ -553,7 +603,7 @@ impl DownlinkParser {
             return if quiet {
                 Verdict::Reject
             } else {
-                Verdict::NeedMore
+                Verdict::NeedMore(len.saturating_sub(buf.len()))
             };
         };
         let Ok(frame) = Downlink::decode(bytes) else {
@@ -561,20 +611,21 @@ impl DownlinkParser {
         };
         let class = self.class(&frame, 0);
         let taken = match rules::need(self.lock, class) {
-            Need::Now => Some(true),
-            Need::Never => Some(false),
-            Need::Follow => followed(buf, len, quiet),
+            Need::Now => Ok(true),
+            Need::Never => Ok(false),
+            Need::Follow => followed(buf, len, quiet).ok_or(1),
             Need::Chain(chain) => self.chain(buf, &frame, len, class, chain, quiet),
         };
         match taken {
-            Some(true) => Verdict::Accept(frame, len, class),
-            Some(false) => Verdict::Reject,
-            None => Verdict::NeedMore,
+            Ok(true) => Verdict::Accept(frame, len, class),
+            Ok(false) => Verdict::Reject,
+            Err(more) => Verdict::NeedMore(more.max(1)),
         }
     }
 
     /// Whether the chain of frames after the candidate (`frame`, `len` bytes) vouches for it;
-    /// `None`: not decided yet.
+    /// `Err(n)`: not decided yet, and not before `n` more bytes (a frame of the chain is
+    /// incomplete: nothing is judged until its last byte).
     fn chain(
         &self,
         buf: &[u8],
@@ -583,7 +634,7 @@ impl DownlinkParser {
         class: Class,
         chain: Chain,
         quiet: bool,
-    ) -> Option<bool> {
+    ) -> Result<bool, usize> {
         let mut counts = self.counts;
         let own = match (frame.kind(), frame.seq()) {
             (Kind::Telemetry(stream), Some(seq)) => {
@@ -626,39 +677,39 @@ impl DownlinkParser {
                         }
                     }
                     (None, _) if at == pos && quiet => {
-                        return Some(quiet_vouches);
+                        return Ok(quiet_vouches);
                     }
-                    (Some(a), None) if Kind::may_start(*a) && !quiet => return undecided(buf),
-                    (None, _) if !quiet => return undecided(buf),
+                    (Some(a), None) if Kind::may_start(*a) && !quiet => return undecided(buf, 1),
+                    (None, _) if !quiet => return undecided(buf, 1),
                     _ => {}
                 }
             }
             let Some((at, kind)) = found else {
-                return Some(false);
+                return Ok(false);
             };
             let end = at.saturating_add(kind.len());
             let Some(bytes) = buf.get(at..end) else {
                 return if quiet || end > WINDOW {
-                    Some(false)
+                    Ok(false)
                 } else {
-                    None
+                    Err(end.saturating_sub(buf.len()))
                 };
             };
             let Ok(next) = Downlink::decode(bytes) else {
-                return Some(false);
+                return Ok(false);
             };
             if chain == Chain::Exact {
                 // Only the next frame, continuing exactly; a stream's first frame (no count to
                 // judge by) is passed over, a reply is not.
                 match (next.kind(), next.seq()) {
                     (Kind::Telemetry(stream), Some(seq)) => match counts.rel(stream, seq, at) {
-                        Rel::Continues => return Some(true),
+                        Rel::Continues => return Ok(true),
                         // On a certain boundary, frames lost upstream.
-                        Rel::Near => return Some(self.lock == Lock::Locked),
+                        Rel::Near => return Ok(self.lock == Lock::Locked),
                         Rel::Unknown => counts.take(stream, seq, false),
-                        Rel::Far => return Some(false),
+                        Rel::Far => return Ok(false),
                     },
-                    _ => return Some(false),
+                    _ => return Ok(false),
                 }
                 pos = end;
                 gap = 0;
@@ -679,7 +730,7 @@ impl DownlinkParser {
                             own_step = Some((step, seen.saturating_add(1)));
                             vouches = false;
                         }
-                        Some(_) => return Some(false),
+                        Some(_) => return Ok(false),
                         None => {
                             own_step = Some((delta, 1));
                             vouches = false;
@@ -687,14 +738,14 @@ impl DownlinkParser {
                     }
                 }
                 match counts.rel(stream, seq, at) {
-                    Rel::Continues if vouches => return Some(true),
-                    Rel::Near if vouches => return Some(chain != Chain::Exact),
+                    Rel::Continues if vouches => return Ok(true),
+                    Rel::Near if vouches => return Ok(chain != Chain::Exact),
                     Rel::Continues | Rel::Near => counts.take(stream, seq, false),
                     Rel::Unknown => counts.take(stream, seq, false),
                     Rel::Far if matches!(chain, Chain::Rebase | Chain::Restart) => {
                         counts.take(stream, seq, false);
                     }
-                    Rel::Far => return Some(false),
+                    Rel::Far => return Ok(false),
                 }
             }
             pos = end;
@@ -732,11 +783,17 @@ impl DownlinkParser {
 
     /// Consumes an accepted frame: counts, counters, lock.
     fn accept(&mut self, frame: &Downlink, len: usize, class: Class) {
+        if let (Class::Continues, Kind::Telemetry(stream), Some(seq)) =
+            (class, frame.kind(), frame.seq())
+        {
+            self.take_continuing(stream, seq, len);
+            return;
+        }
         // A far count taken on a certain boundary is believed only if its own stream's next
         // frame continues it (the board moved its count on); otherwise it is a damaged count
         // byte, and the stream moves on by a step.
         let believed = class != Class::Far
-            || self.chain(self.buf.as_slice(), frame, len, class, Chain::Own, false) == Some(true);
+            || self.chain(self.buf.as_slice(), frame, len, class, Chain::Own, false) == Ok(true);
         // Frames lost (a near count) teach no step.
         let near = match (class, frame.kind(), frame.seq()) {
             (Class::Near, ..) => true,
@@ -770,12 +827,28 @@ impl DownlinkParser {
     }
 }
 
-/// Not decided: more bytes are needed, unless the window is already full.
-fn undecided(buf: &[u8]) -> Option<bool> {
+impl DownlinkParser {
+    /// [`accept`](Self::accept) for telemetry whose count continues its stream (row 1): the
+    /// frame's bytes leave the window, its count and step are taken, the parser is Locked.
+    fn take_continuing(&mut self, stream: Stream, seq: u8, len: usize) {
+        self.buf.drop_front(len);
+        self.counts.bytes(len);
+        self.since_frame = 0;
+        self.stats.count_frame(Kind::Telemetry(stream));
+        self.counts.take(stream, seq, true);
+        if self.lock == Lock::Hunting {
+            self.stats.resyncs = self.stats.resyncs.wrapping_add(1);
+        }
+        self.lock = Lock::Locked;
+    }
+}
+
+/// Not decided: `more` bytes are needed, unless the window is already full.
+fn undecided(buf: &[u8], more: usize) -> Result<bool, usize> {
     if buf.len() >= WINDOW {
-        Some(false)
+        Ok(false)
     } else {
-        None
+        Err(more)
     }
 }
 
