@@ -6,6 +6,7 @@
 
 pub mod board;
 pub mod channel;
+pub mod qemu;
 pub mod score;
 pub mod splice;
 

@@ -1,16 +1,22 @@
-//! The workspace's tasks, run with `cargo xtask <task>` (an alias in `.cargo/config.toml`):
-//! `demo`, `test`, `sweep`, `bench`, `fuzz [SECONDS]`.
+//! The workspace's tasks, run with `cargo xtask <task>` (an alias in `.cargo/config.toml`).
 //!
 //! | task | what it does |
 //! |---|---|
-//! | `demo` | the main job: today a host demo (frames built, a noisy board stream parsed) |
-//! | `test` | everything CI checks: format, lints, tests, docs, `no_std` builds for Cortex-M, the link-time no-panic proof, and a short, repeatable run of every fuzz target (fixed seed and run count) |
+//! | `demo` | the main job: the bring-up firmware in QEMU (mps2-an386, Cortex-M4) against the simulated chassis over TCP, its log decoded, a verdict |
+//! | `test` | everything CI checks: format, lints, tests, docs, `no_std` builds for Cortex-M, the link-time no-panic proofs (host and firmware), every board's firmware, the size and instruction-count budgets, the end-to-end tests in QEMU, and a short, repeatable run of every fuzz target (fixed seed and run count) |
+//! | `size` | flash and RAM of every board's firmware, and the protocol crate's share (size probes) |
+//! | `icount` | the downlink parser's instructions per byte on the emulated Cortex-M4 and Cortex-M0 |
 //! | `fuzz [SECONDS]` | only the fuzz targets, each for SECONDS (default 30), exploring: random seed, corpora kept |
 //! | `sweep` | the full noise sweep of the downlink parser over every stream model (a few minutes; not part of `test`) |
 //! | `bench` | the parser beside its peers (sbus-rs, uf-crsf, crsf) in one run: a table with the ratios (not part of `test`, which only builds it) |
+//! | `host-demo` | frames built and a noisy board stream parsed, on the host |
+//! | `qemu ELF [--scenario NAME]` | boots a firmware in QEMU against the simulated chassis (the QEMU board's cargo runner) |
 //!
-//! Each task installs what it needs (rustup targets, the nightly toolchain and cargo-fuzz)
-//! before it runs, so a fresh machine with rustup and cargo needs nothing else.
+//! Each task installs what it needs (rustup targets, `qemu-system-arm` through apt when run as
+//! root, defmt-print, the nightly toolchain and cargo-fuzz) before it runs, so a fresh machine
+//! with rustup and cargo needs nothing else.
+
+mod firmware;
 
 use std::process::{Command, ExitCode};
 
@@ -20,7 +26,11 @@ const THUMB_TARGETS: [&str; 2] = ["thumbv6m-none-eabi", "thumbv7em-none-eabihf"]
 fn main() -> ExitCode {
     let task = std::env::args().nth(1).unwrap_or_default();
     let result = match task.as_str() {
-        "demo" => demo(),
+        "demo" => firmware::demo(),
+        "host-demo" => host_demo(),
+        "size" => firmware::size(),
+        "icount" => firmware::icount(),
+        "qemu" => firmware::qemu(&std::env::args().skip(2).collect::<Vec<_>>()),
         "test" => test(),
         "sweep" => sweep(),
         "bench" => bench(),
@@ -34,7 +44,10 @@ fn main() -> ExitCode {
             }
         }
         _ => {
-            eprintln!("usage: cargo xtask <demo | test | sweep | bench | fuzz [SECONDS]>");
+            eprintln!(
+                "usage: cargo xtask <demo | test | size | icount | sweep | bench | fuzz [SECONDS] | \
+                 host-demo | qemu FIRMWARE.elf>"
+            );
             return ExitCode::from(2);
         }
     };
@@ -121,7 +134,7 @@ fn host_tests(kind: &str, name: &str, args: &[&str]) -> Result<(), String> {
     cargo(&[&run[..], args].concat())
 }
 
-fn demo() -> Result<(), String> {
+fn host_demo() -> Result<(), String> {
     host_tests("--example", "demo", &[])
 }
 
@@ -301,6 +314,7 @@ fn test() -> Result<(), String> {
         "--no-run",
     ])?;
     msrv()?;
+    firmware::test()?;
     fuzz(FuzzRun::Repeatable)
 }
 

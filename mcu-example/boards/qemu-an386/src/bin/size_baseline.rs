@@ -1,0 +1,26 @@
+//! Size probe: the board alone (UART echo, SysTick clock). `cargo xtask size` subtracts it from
+//! the other probes.
+
+#![no_std]
+#![no_main]
+
+use board_qemu_an386::time;
+use chassis_protocol::driver::Clock;
+use embedded_io::{Read, Write};
+
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    let mut uart = board_qemu_an386::init();
+    let mut byte = [0u8; 1];
+    loop {
+        if uart.read(&mut byte).is_ok() {
+            let t = time::Millis.now_ms() as u8;
+            let _ = uart.write(&[byte[0] ^ t]);
+        }
+    }
+}
+
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo) -> ! {
+    loop {}
+}

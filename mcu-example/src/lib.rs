@@ -1,0 +1,571 @@
+//! The chassis bring-up, written once: every board under `boards/` runs [`bring_up`] over its
+//! own UART, through the blocking or the async driver (see [`link`]).
+//!
+//! It is written as `async` code and compiled one of two ways: as is (feature `async`, for an
+//! executor such as embassy's), or as plain blocking code (feature `blocking`: the
+//! `maybe-async` macro removes every `async` and `.await`), so that a board without an executor
+//! runs it as ordinary function calls, and its firmware has no future that could be polled
+//! after it finished (a panic path the no-panic proof would find).
+//!
+//! The sequence, each step a named [`Check`]:
+//!
+//! 1. [`Check::Link`]: telemetry arrives; each stream's rate is measured over
+//!    [`Plan::listen_ms`] and must be near its nominal one (IMU 100 Hz, encoders 25 Hz,
+//!    battery 1 Hz).
+//! 2. [`Check::Settings`]: every register and the pending angle are read (each register read
+//!    twice until two replies agree: there is no checksum) into a [`Snapshot`], logged and
+//!    encoded with postcard (what a firmware would keep in flash to restore later).
+//! 3. [`Check::DriveType`]: the build's drive type ([`Plan::drive`]) is written to the system
+//!    mode register if the board has another one, and read back.
+//! 4. [`Check::Forward`], [`Check::Strafe`]: a short drive each, re-sent every
+//!    [`Plan::command_period_ms`]; the encoders must count.
+//! 5. [`Check::Turn`]: one 90° turn, sent **once** (the board adds turns up); the gyro must see
+//!    it and the pending angle must reach 0.
+//! 6. [`Check::Stop`]: after a stop, the encoders stand still.
+//! 7. [`Check::Battery`]: the battery is above its cut-off (a reading at or below it is judged
+//!    again on the next battery frame: one frame can carry a changed byte).
+//! 8. [`Check::ControlLoop`]: a steady control loop (slow forward, the velocity re-sent each
+//!    period, a verified register read every [`Plan::loop_read_every_ms`] while moving): no
+//!    failsafe stop; then stop.
+//!
+//! Any failure stops the chassis (best effort) and names its check. Nothing here panics: the
+//! boards' release builds prove it at link time.
+
+#![no_std]
+#![warn(missing_docs)]
+
+#[cfg(all(feature = "blocking", feature = "async"))]
+compile_error!("features `blocking` and `async` exclude each other: a board picks one");
+
+pub mod link;
+
+/// embassy-time as the driver's clock (feature `embassy`).
+#[cfg(feature = "embassy")]
+pub mod embassy {
+    /// Milliseconds of `embassy_time::Instant` (a handle: copy it freely).
+    #[derive(Clone, Copy, Debug, Default)]
+    pub struct Millis;
+
+    impl chassis_protocol::driver::Clock for Millis {
+        fn now_ms(&mut self) -> u64 {
+            embassy_time::Instant::now().as_millis()
+        }
+    }
+}
+
+use chassis_protocol::driver::Event;
+use chassis_protocol::registers::Snapshot;
+use chassis_protocol::{Downlink, DriveType, Kind, Register, Stream, Turn, Velocity, Write};
+pub use link::{Link, LinkError};
+
+/// What the bring-up does, and how long each step takes.
+#[derive(Clone, Copy, Debug, defmt::Format)]
+pub struct Plan {
+    /// The chassis's drive type, as built.
+    pub drive: DriveType,
+    /// How long telemetry is listened to before rates are judged, ms (at least 1 s: battery
+    /// frames come at 1 Hz).
+    pub listen_ms: u64,
+    /// Speed of the motion tests (the velocity frame's units).
+    pub speed: i32,
+    /// How long each straight motion lasts, ms.
+    pub drive_ms: u64,
+    /// The motion commands are re-sent this often, ms (well inside the driver's failsafe).
+    pub command_period_ms: u64,
+    /// The one-shot turn, 0.1°.
+    pub turn_deci_degrees: i32,
+    /// The turn must be done within this, ms.
+    pub turn_timeout_ms: u64,
+    /// How long the steady control loop runs, ms.
+    pub loop_ms: u64,
+    /// A register read every this many ms during the control loop.
+    pub loop_read_every_ms: u64,
+    /// The gyro Z reading (raw counts) a turn must exceed at least once: well above the
+    /// sensor's noise at rest.
+    pub gyro_threshold: u16,
+    /// Battery voltage below which the bring-up fails when the board uses its built-in table
+    /// (0.01 V).
+    pub min_centivolts: u16,
+}
+
+impl Plan {
+    /// The bring-up every board runs by default: about 6 s end to end.
+    pub const DEFAULT: Plan = Plan {
+        drive: DriveType::Mecanum,
+        listen_ms: 1_200,
+        speed: 300,
+        drive_ms: 400,
+        command_period_ms: 40,
+        turn_deci_degrees: 900,
+        turn_timeout_ms: 3_000,
+        loop_ms: 1_500,
+        loop_read_every_ms: 250,
+        gyro_threshold: 20,
+        min_centivolts: 1_050,
+    };
+}
+
+/// A step of the bring-up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
+pub enum Check {
+    /// Telemetry arrives at its rates.
+    Link,
+    /// Every register read.
+    Settings,
+    /// The build's drive type is set.
+    DriveType,
+    /// Forward: the encoders count.
+    Forward,
+    /// Sideways: the encoders count.
+    Strafe,
+    /// The one-shot turn: the gyro sees it, the pending angle reaches 0.
+    Turn,
+    /// After a stop the encoders stand still.
+    Stop,
+    /// The battery is above its cut-off.
+    Battery,
+    /// The steady control loop: no failsafe stop while reads go on.
+    ControlLoop,
+}
+
+impl Check {
+    /// The process exit code under QEMU when this check fails (0 means every check passed).
+    pub const fn exit_code(self) -> i32 {
+        match self {
+            Check::Link => 10,
+            Check::Settings => 11,
+            Check::DriveType => 12,
+            Check::Forward => 13,
+            Check::Strafe => 14,
+            Check::Turn => 15,
+            Check::Stop => 16,
+            Check::Battery => 17,
+            Check::ControlLoop => 18,
+        }
+    }
+}
+
+/// Why a check failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
+pub enum Why {
+    /// The driver failed (transport error, timeout, unconfirmed read…).
+    Driver(LinkError),
+    /// A stream sent nothing, or too few frames: (stream, frames per 10 s measured).
+    Rate(Stream, u32),
+    /// The encoders did not move.
+    EncodersStill,
+    /// The encoders kept moving after a stop.
+    EncodersMoving,
+    /// The gyro saw no rotation.
+    GyroStill,
+    /// The turn was not done in time: the angle still pending, 0.1°.
+    TurnPending(i32),
+    /// The drive type read back is not the one written.
+    DriveTypeNotSet(DriveType),
+    /// The battery is at or below the limit: (centivolts, limit).
+    LowBattery(u16, u16),
+    /// No battery frame to judge.
+    NoBattery,
+    /// The driver's failsafe stopped the chassis: the board went quiet.
+    FailsafeStop,
+}
+
+/// A failed check and why.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
+pub struct Failure {
+    /// The check that failed.
+    pub check: Check,
+    /// Why.
+    pub why: Why,
+}
+
+/// What a passed bring-up measured.
+#[derive(Clone, Copy, Debug, Default, defmt::Format)]
+pub struct Report {
+    /// Frames per 10 s of each stream: IMU, encoders, battery.
+    pub rates_per_10s: [u32; 3],
+    /// Every register.
+    pub snapshot: Snapshot,
+    /// The angle pending before the turn, 0.1°.
+    pub pending_before: i32,
+    /// Encoder ticks counted during forward and sideways (sum of |Δ| over the wheels).
+    pub ticks: [u32; 2],
+    /// The largest |gyro Z| seen during the turn.
+    pub gyro_peak: u16,
+    /// Battery voltage, 0.01 V, and percent.
+    pub battery: (u16, u16),
+    /// Register reads done while moving in the control loop.
+    pub loop_reads: u32,
+    /// Telemetry frames the parser counted as missed over the whole bring-up.
+    pub missed: u32,
+}
+
+/// The longest postcard encoding of a [`Snapshot`] (varints: 3 bytes per u16, 5 per u32).
+pub const SNAPSHOT_POSTCARD_MAX: usize = 3 + 5 + 5 + 5 + 5 + 3 + 3 + 3 + 3;
+
+/// Encodes `snapshot` with postcard into `buf`; the bytes written.
+pub fn encode_snapshot<'a>(
+    snapshot: &Snapshot,
+    buf: &'a mut [u8; SNAPSHOT_POSTCARD_MAX],
+) -> &'a [u8] {
+    match postcard::to_slice(snapshot, buf) {
+        Ok(bytes) => bytes,
+        Err(_) => &[],
+    }
+}
+
+fn fail(check: Check) -> impl Fn(LinkError) -> Failure {
+    move |e| Failure {
+        check,
+        why: Why::Driver(e),
+    }
+}
+
+/// Runs the whole bring-up on `link`. On a failure the chassis is stopped (best effort) and
+/// the failed check returned.
+#[maybe_async::maybe_async]
+pub async fn bring_up<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
+    let result = steps(link, plan).await;
+    if let Err(failure) = &result {
+        defmt::error!("bring-up: {} failed: {}", failure.check, failure.why);
+        if let Err(e) = link.stop().await {
+            defmt::error!("stop after the failure: {}", e);
+        }
+    }
+    result
+}
+
+/// What a board on real hardware does: runs the bring-up, logs its verdict, then keeps reading
+/// telemetry for ever (the chassis stopped, so the failsafe has nothing to do).
+#[maybe_async::maybe_async]
+pub async fn bring_up_and_park<L: Link>(link: &mut L, plan: &Plan) -> ! {
+    match bring_up(link, plan).await {
+        Ok(report) => defmt::info!("PASS: every check passed: {}", report),
+        Err(failure) => defmt::error!("FAIL: {} ({})", failure.check, failure.why),
+    }
+    loop {
+        if let Err(e) = link.poll().await {
+            defmt::warn!("link: {}", e);
+        }
+    }
+}
+
+#[maybe_async::maybe_async]
+async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
+    let mut report = Report::default();
+
+    // 1. Link up: count each stream's frames over the listening time.
+    defmt::info!("[link] listening to telemetry for {} ms", plan.listen_ms);
+    let mut counts = [0u32; 3];
+    let start = link.now_ms();
+    while link.now_ms().saturating_sub(start) < plan.listen_ms {
+        if let Some(Event::Telemetry(frame)) = link.poll().await.map_err(fail(Check::Link))? {
+            if let Kind::Telemetry(stream) = frame.kind() {
+                if let Some(c) = counts.get_mut(stream.index()) {
+                    *c = c.saturating_add(1);
+                }
+            }
+        }
+    }
+    // 32-bit arithmetic: a Cortex-M divides it in hardware (64-bit division is a library
+    // routine of nearly 1 KB); a listening time fits, and so do its frames × 10 000.
+    let elapsed = u32::try_from(link.now_ms().saturating_sub(start).max(1)).unwrap_or(u32::MAX);
+    for stream in Stream::ALL {
+        let i = stream.index();
+        let frames = counts.get(i).copied().unwrap_or(0);
+        let per_10s = frames
+            .saturating_mul(10_000)
+            .checked_div(elapsed)
+            .unwrap_or(0);
+        if let Some(r) = report.rates_per_10s.get_mut(i) {
+            *r = per_10s;
+        }
+        // At least 70 % of the nominal rate (battery: one frame in the window).
+        let nominal_per_10s = u32::from(stream.rate_hz()) * 10;
+        let enough = match stream {
+            Stream::Battery => frames >= 1,
+            _ => per_10s >= nominal_per_10s * 7 / 10,
+        };
+        if !enough {
+            defmt::warn!(
+                "[link] frames {} in {} ms; parser {}",
+                counts,
+                elapsed,
+                link.core().parser_stats()
+            );
+            return Err(Failure {
+                check: Check::Link,
+                why: Why::Rate(stream, per_10s),
+            });
+        }
+    }
+    defmt::info!(
+        "[link] up: IMU {} Hz, encoders {} Hz, battery {} frame(s)",
+        report.rates_per_10s[0] / 10,
+        report.rates_per_10s[1] / 10,
+        counts[2]
+    );
+
+    // 2. Every register, and the pending angle.
+    let snapshot = link.read_settings().await.map_err(fail(Check::Settings))?;
+    report.pending_before = link.turn_remaining().await.map_err(fail(Check::Settings))?;
+    report.snapshot = snapshot;
+    defmt::info!("[settings] {}", snapshot);
+    defmt::info!("[settings] pending angle {} (0.1°)", report.pending_before);
+    let mut buf = [0u8; SNAPSHOT_POSTCARD_MAX];
+    let encoded = encode_snapshot(&snapshot, &mut buf);
+    defmt::info!(
+        "[settings] postcard ({} bytes): {=[u8]:02x}",
+        encoded.len(),
+        encoded
+    );
+
+    // 3. The build's drive type.
+    if snapshot.system_mode.drive_type() == plan.drive {
+        defmt::info!("[drive-type] already {}", plan.drive);
+    } else {
+        let mode = snapshot.system_mode.with_drive_type(plan.drive);
+        link.write(Write::SystemMode(mode))
+            .await
+            .map_err(fail(Check::DriveType))?;
+        let raw = link
+            .read_verified(Register::SystemMode)
+            .await
+            .map_err(fail(Check::DriveType))?;
+        let read_back = chassis_protocol::SystemMode::from_bits(raw).drive_type();
+        if read_back != plan.drive {
+            return Err(Failure {
+                check: Check::DriveType,
+                why: Why::DriveTypeNotSet(read_back),
+            });
+        }
+        defmt::info!(
+            "[drive-type] {} -> {}",
+            snapshot.system_mode.drive_type(),
+            plan.drive
+        );
+    }
+
+    // 4. Forward and sideways: the encoders must count.
+    let failsafe_before = link.core().failsafe_stops();
+    for (check, velocity, slot) in [
+        (Check::Forward, Velocity::new(0, plan.speed, 0), 0usize),
+        (Check::Strafe, Velocity::new(plan.speed, 0, 0), 1),
+    ] {
+        let moved = drive_for(link, plan, velocity, plan.drive_ms, check).await?;
+        if link.core().failsafe_stops() != failsafe_before {
+            return Err(Failure {
+                check,
+                why: Why::FailsafeStop,
+            });
+        }
+        if moved.ticks == 0 {
+            return Err(Failure {
+                check,
+                why: Why::EncodersStill,
+            });
+        }
+        if let Some(t) = report.ticks.get_mut(slot) {
+            *t = moved.ticks;
+        }
+        defmt::info!("[{}] encoders counted {} ticks", check, moved.ticks);
+    }
+
+    // 5. One turn, sent once; wait for the pending angle to reach 0.
+    link.stop().await.map_err(fail(Check::Turn))?;
+    link.turn(Turn::by_deci_degrees(plan.turn_deci_degrees))
+        .await
+        .map_err(fail(Check::Turn))?;
+    defmt::info!("[turn] {} (0.1°) sent once", plan.turn_deci_degrees);
+    let start = link.now_ms();
+    let mut next_read = start.saturating_add(200);
+    let mut gyro_peak = 0u16;
+    loop {
+        if link.core().failsafe_stops() != failsafe_before {
+            return Err(Failure {
+                check: Check::Turn,
+                why: Why::FailsafeStop,
+            });
+        }
+        let now = link.now_ms();
+        if let Some(Event::Telemetry(Downlink::Imu(imu))) =
+            link.poll().await.map_err(fail(Check::Turn))?
+        {
+            gyro_peak = gyro_peak.max(imu.gyro[2].unsigned_abs());
+        }
+        if now >= next_read {
+            next_read = now.saturating_add(200);
+            let pending = link.turn_remaining().await.map_err(fail(Check::Turn))?;
+            if pending.unsigned_abs() <= 10 {
+                break;
+            }
+            if now.saturating_sub(start) > plan.turn_timeout_ms {
+                return Err(Failure {
+                    check: Check::Turn,
+                    why: Why::TurnPending(pending),
+                });
+            }
+        }
+    }
+    report.gyro_peak = gyro_peak;
+    if gyro_peak < plan.gyro_threshold {
+        return Err(Failure {
+            check: Check::Turn,
+            why: Why::GyroStill,
+        });
+    }
+    defmt::info!(
+        "[turn] done in {} ms, gyro Z peak {}",
+        link.now_ms().saturating_sub(start),
+        gyro_peak
+    );
+
+    // 6. Stop: the encoders stand still (after 100 ms to settle).
+    link.stop().await.map_err(fail(Check::Stop))?;
+    let _ = drive_for(link, plan, Velocity::new(0, 0, 0), 100, Check::Stop).await?;
+    let still = drive_for(link, plan, Velocity::new(0, 0, 0), 200, Check::Stop).await?;
+    if still.ticks != 0 {
+        return Err(Failure {
+            check: Check::Stop,
+            why: Why::EncodersMoving,
+        });
+    }
+    defmt::info!("[stop] encoders still");
+
+    // 7. Battery: above the cut-off. One frame can carry a changed byte (no checksum), so a
+    // reading at or below the limit is judged again on the next frame before it fails.
+    let limit = if snapshot.battery_cutoff_centivolts == 0x7FFF {
+        plan.min_centivolts
+    } else {
+        snapshot.battery_cutoff_centivolts
+    };
+    let Some(first) = link.core().battery() else {
+        return Err(Failure {
+            check: Check::Battery,
+            why: Why::NoBattery,
+        });
+    };
+    let mut battery = first.value;
+    if battery.centivolts <= limit {
+        let start = link.now_ms();
+        while link.now_ms().saturating_sub(start) < 1_500 {
+            link.poll().await.map_err(fail(Check::Battery))?;
+            if let Some(next) = link.core().battery() {
+                if next.at_ms > first.at_ms {
+                    battery = next.value;
+                    break;
+                }
+            }
+        }
+    }
+    report.battery = (battery.centivolts, battery.percent);
+    if battery.centivolts <= limit {
+        return Err(Failure {
+            check: Check::Battery,
+            why: Why::LowBattery(battery.centivolts, limit),
+        });
+    }
+    defmt::info!(
+        "[battery] {} cV ({} %), cut-off {} cV",
+        battery.centivolts,
+        battery.percent,
+        limit
+    );
+
+    // 8. The steady control loop, reads while moving.
+    let cruise = Velocity::new(0, plan.speed / 2, 0);
+    let start = link.now_ms();
+    let mut next_send = start;
+    let mut next_read = start.saturating_add(plan.loop_read_every_ms);
+    let mut reads = 0u32;
+    while link.now_ms().saturating_sub(start) < plan.loop_ms {
+        let now = link.now_ms();
+        if now >= next_send {
+            next_send = now.saturating_add(plan.command_period_ms);
+            link.set_velocity(cruise)
+                .await
+                .map_err(fail(Check::ControlLoop))?;
+        }
+        if now >= next_read {
+            next_read = now.saturating_add(plan.loop_read_every_ms);
+            let _ = link
+                .read_verified(Register::MotorVoltage)
+                .await
+                .map_err(fail(Check::ControlLoop))?;
+            reads = reads.saturating_add(1);
+        }
+        link.poll().await.map_err(fail(Check::ControlLoop))?;
+        // The driver stopped a board that went quiet: never command motion past that.
+        if link.core().failsafe_stops() != failsafe_before {
+            return Err(Failure {
+                check: Check::ControlLoop,
+                why: Why::FailsafeStop,
+            });
+        }
+    }
+    link.stop().await.map_err(fail(Check::ControlLoop))?;
+    report.loop_reads = reads;
+    defmt::info!(
+        "[control-loop] {} ms, {} reads while moving, no failsafe stop",
+        plan.loop_ms,
+        reads
+    );
+
+    let missed = Stream::ALL
+        .into_iter()
+        .map(|s| link.core().stream(s).missed)
+        .fold(0u32, u32::saturating_add);
+    report.missed = missed;
+    Ok(report)
+}
+
+/// What a timed drive saw.
+struct Moved {
+    /// Sum over the wheels of |ticks at the end − ticks at the start|.
+    ticks: u32,
+}
+
+/// Drives at `velocity` for `ms`, re-sending it every command period, taking telemetry in.
+#[maybe_async::maybe_async]
+async fn drive_for<L: Link>(
+    link: &mut L,
+    plan: &Plan,
+    velocity: Velocity,
+    ms: u64,
+    check: Check,
+) -> Result<Moved, Failure> {
+    let start = link.now_ms();
+    let mut next_send = start;
+    let mut first: Option<[i16; 4]> = None;
+    let mut last: Option<[i16; 4]> = None;
+    let failsafe_before = link.core().failsafe_stops();
+    while link.now_ms().saturating_sub(start) < ms {
+        // The driver stopped a board that went quiet: never command motion past that.
+        if link.core().failsafe_stops() != failsafe_before {
+            return Err(Failure {
+                check,
+                why: Why::FailsafeStop,
+            });
+        }
+        let now = link.now_ms();
+        if now >= next_send && velocity != Velocity::new(0, 0, 0) {
+            next_send = now.saturating_add(plan.command_period_ms);
+            link.set_velocity(velocity).await.map_err(fail(check))?;
+        }
+        if let Some(Event::Telemetry(Downlink::Encoders(e))) =
+            link.poll().await.map_err(fail(check))?
+        {
+            first.get_or_insert(e.ticks);
+            last = Some(e.ticks);
+        }
+    }
+    let ticks = match (first, last) {
+        (Some(a), Some(b)) => a
+            .iter()
+            .zip(b.iter())
+            .map(|(a, b)| u32::from(b.wrapping_sub(*a).unsigned_abs()))
+            .fold(0u32, u32::saturating_add),
+        _ => 0,
+    };
+    Ok(Moved { ticks })
+}
