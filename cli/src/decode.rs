@@ -1,0 +1,379 @@
+//! `chassis decode`: a capture in, one JSON object per frame per line out (JSON Lines), in
+//! stream order, and a one-line summary on stderr.
+//!
+//! The JSON is a public contract (documented in the README): every object has `"offset"` (the
+//! byte offset of the frame's first byte in the input) and `"frame"`, the fields of its kind,
+//! and `"t"` (seconds) when the capture has time stamps.
+
+use chassis_protocol::{Command, Downlink, DownlinkParser, Setting, UplinkParser};
+use serde_json::{Value, json};
+
+/// How the input is written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Input {
+    /// The bytes themselves.
+    Raw,
+    /// Hex text: pairs of digits, spaces, commas, newlines and `0x` allowed.
+    Hex,
+    /// A logic analyser's async-serial export (Saleae Logic 1 or 2 CSV): time stamps and bytes;
+    /// gaps in the time stamps are quiet lines for the parser.
+    SaleaeCsv,
+}
+
+/// How frames are written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    /// One JSON object per line.
+    Json,
+    /// One line of text per frame.
+    Text,
+}
+
+/// A gap between two bytes longer than this is a quiet line (two and a half characters at
+/// 115 200 bps are 0.2 ms; a board's frames come back to back).
+pub const QUIET_GAP_S: f64 = 0.002;
+
+/// The bytes of a capture, with the time of each when it has them.
+#[derive(Debug, Default)]
+pub struct Capture {
+    /// The bytes.
+    pub bytes: Vec<u8>,
+    /// Their time stamps in seconds, if the capture has them (as many as the bytes).
+    pub times: Option<Vec<f64>>,
+}
+
+/// Reads `data` as `input`.
+pub fn read_capture(data: &[u8], input: Input) -> Result<Capture, String> {
+    match input {
+        Input::Raw => Ok(Capture {
+            bytes: data.to_vec(),
+            times: None,
+        }),
+        Input::Hex => parse_hex(data).map(|bytes| Capture { bytes, times: None }),
+        Input::SaleaeCsv => parse_saleae(data),
+    }
+}
+
+/// Hex text to bytes: whitespace and commas separate, `0x` may lead a group, a group holds an
+/// even number of digits.
+pub fn parse_hex(data: &[u8]) -> Result<Vec<u8>, String> {
+    let text = std::str::from_utf8(data).map_err(|_| "hex input: not text".to_string())?;
+    let mut bytes = Vec::new();
+    for (line_no, line) in text.lines().enumerate() {
+        for group in line.split(|c: char| c.is_whitespace() || c == ',') {
+            if group.is_empty() {
+                continue;
+            }
+            let digits = group
+                .strip_prefix("0x")
+                .or_else(|| group.strip_prefix("0X"))
+                .unwrap_or(group);
+            if digits.len() % 2 != 0 {
+                return Err(format!(
+                    "hex input, line {}: {group:?} has an odd number of digits",
+                    line_no + 1
+                ));
+            }
+            for pair in digits.as_bytes().chunks(2) {
+                let pair = std::str::from_utf8(pair).unwrap_or("");
+                let byte = u8::from_str_radix(pair, 16).map_err(|_| {
+                    format!("hex input, line {}: {group:?} is not hex", line_no + 1)
+                })?;
+                bytes.push(byte);
+            }
+        }
+    }
+    Ok(bytes)
+}
+
+/// A Saleae async-serial export: a header naming a time column (`Time [s]`, `start_time`) and
+/// a byte column (`Value`, `data`), then one row per byte.
+pub fn parse_saleae(data: &[u8]) -> Result<Capture, String> {
+    let text = std::str::from_utf8(data).map_err(|_| "CSV input: not text".to_string())?;
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
+    let Some((_, header)) = lines.next() else {
+        return Err("CSV input: empty".into());
+    };
+    let columns: Vec<String> = split_csv(header)
+        .iter()
+        .map(|c| c.trim().to_ascii_lowercase())
+        .collect();
+    let time_col = columns.iter().position(|c| c.contains("time"));
+    let value_col = columns
+        .iter()
+        .position(|c| c == "value" || c == "data" || c.starts_with("value"));
+    let (Some(time_col), Some(value_col)) = (time_col, value_col) else {
+        return Err(format!(
+            "CSV input: not an async-serial export (its header {header:?} names no time and \
+             value/data columns)"
+        ));
+    };
+    let type_col = columns.iter().position(|c| c == "type");
+    let mut capture = Capture {
+        bytes: Vec::new(),
+        times: Some(Vec::new()),
+    };
+    for (line_no, line) in lines {
+        let fields = split_csv(line);
+        // Logic 2 exports errors and other rows with a type other than "data".
+        if let Some(t) = type_col.and_then(|i| fields.get(i)) {
+            if !t.trim().eq_ignore_ascii_case("data") {
+                continue;
+            }
+        }
+        let (Some(time), Some(value)) = (fields.get(time_col), fields.get(value_col)) else {
+            return Err(format!("CSV input, line {}: too few columns", line_no + 1));
+        };
+        let time: f64 = time
+            .trim()
+            .parse()
+            .map_err(|_| format!("CSV input, line {}: {time:?} is not a time", line_no + 1))?;
+        let value = value.trim().trim_matches('\'');
+        let byte = match value
+            .strip_prefix("0x")
+            .or_else(|| value.strip_prefix("0X"))
+        {
+            Some(hex) => u8::from_str_radix(hex, 16).ok(),
+            None => value.parse::<u8>().ok(),
+        }
+        .ok_or_else(|| format!("CSV input, line {}: {value:?} is not a byte", line_no + 1))?;
+        capture.bytes.push(byte);
+        if let Some(times) = capture.times.as_mut() {
+            times.push(time);
+        }
+    }
+    Ok(capture)
+}
+
+/// Fields of one CSV line (double quotes group, `""` inside quotes is a quote).
+fn split_csv(line: &str) -> Vec<String> {
+    let mut fields = Vec::new();
+    let mut field = String::new();
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' if quoted && chars.peek() == Some(&'"') => {
+                field.push('"');
+                let _ = chars.next();
+            }
+            '"' => quoted = !quoted,
+            ',' if !quoted => fields.push(std::mem::take(&mut field)),
+            _ => field.push(c),
+        }
+    }
+    fields.push(field);
+    fields
+}
+
+/// One decoded frame and where it starts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Found {
+    /// Byte offset of its first byte in the input.
+    pub offset: usize,
+    /// The frame as JSON (offset and time included).
+    pub json: Value,
+    /// One line of text.
+    pub text: String,
+}
+
+/// What a decode found, with its counters.
+#[derive(Debug, Default)]
+pub struct Decoded {
+    /// The frames, in stream order.
+    pub frames: Vec<Found>,
+    /// The summary line.
+    pub summary: String,
+}
+
+/// Decodes `capture` (board → master, or master → board with `uplink`).
+pub fn decode(capture: &Capture, uplink: bool) -> Decoded {
+    let mut out = Decoded::default();
+    let mut search_from = 0usize;
+    let mut place = |wire: &[u8], upto: usize| -> usize {
+        // The frame's bytes, from where the previous frame ended up to the byte that let it
+        // out: the parser emits frames in order and never two from the same bytes.
+        let end = upto.min(capture.bytes.len());
+        let found = capture
+            .bytes
+            .get(search_from..end)
+            .and_then(|hay| hay.windows(wire.len()).position(|w| w == wire))
+            .map(|p| p + search_from)
+            .unwrap_or(search_from);
+        search_from = found + wire.len();
+        found
+    };
+    let time_of = |offset: usize| capture.times.as_ref().and_then(|t| t.get(offset).copied());
+    let gap_before = |i: usize| -> Option<u32> {
+        let times = capture.times.as_ref()?;
+        let (a, b) = (times.get(i.checked_sub(1)?)?, times.get(i)?);
+        let gap = b - a;
+        (gap > QUIET_GAP_S).then(|| (gap * 1000.0).round().clamp(1.0, 60_000.0) as u32)
+    };
+    if uplink {
+        let mut parser = UplinkParser::new();
+        for (i, &byte) in capture.bytes.iter().enumerate() {
+            if gap_before(i).is_some() {
+                parser.idle();
+            }
+            if let Some(command) = parser.push(byte) {
+                let (json, text) = describe_uplink(&command);
+                // Encoding consumes the command (a turn is sent once, even in a decoder).
+                let wire = command.encode();
+                let offset = place(wire.as_slice(), i + 1);
+                out.frames.push(found(offset, time_of(offset), json, &text));
+            }
+        }
+        let s = parser.stats();
+        out.summary = format!(
+            "{} bytes: {} frames; {} bytes discarded, {} resyncs",
+            capture.bytes.len(),
+            s.frames,
+            s.discarded,
+            s.resyncs
+        );
+    } else {
+        let mut parser = DownlinkParser::new();
+        let mut emit = |frame: Downlink, upto: usize, out: &mut Decoded| {
+            let (json, text) = describe_downlink(&frame);
+            let offset = place(frame.encode().as_slice(), upto);
+            out.frames.push(found(offset, time_of(offset), json, &text));
+        };
+        for (i, &byte) in capture.bytes.iter().enumerate() {
+            if let Some(ms) = gap_before(i) {
+                while let Some(frame) = parser.quiet(ms) {
+                    emit(frame, i, &mut out);
+                }
+            }
+            if let Some(frame) = parser.push(byte) {
+                emit(frame, i + 1, &mut out);
+            }
+            while let Some(frame) = parser.poll() {
+                emit(frame, i + 1, &mut out);
+            }
+        }
+        // The end of a capture is a quiet line.
+        while let Some(frame) = parser.quiet(1_000) {
+            emit(frame, capture.bytes.len(), &mut out);
+        }
+        let s = parser.stats();
+        let gaps: u32 = s.gaps.iter().sum();
+        let missed: u32 = s.missed.iter().sum();
+        out.summary = format!(
+            "{} bytes: imu {}, encoders {}, battery {}, reply {}; {} bytes discarded; {} count gaps ({} frames missed)",
+            capture.bytes.len(),
+            s.frames[0],
+            s.frames[1],
+            s.frames[2],
+            s.frames[3],
+            s.discarded,
+            gaps,
+            missed
+        );
+    }
+    out
+}
+
+/// A frame's description placed in the input: `offset` (and `t`) added to its JSON, the offset
+/// in front of its text.
+fn found(offset: usize, t: Option<f64>, mut json: Value, text: &str) -> Found {
+    if let Some(map) = json.as_object_mut() {
+        map.insert("offset".into(), json!(offset));
+        if let Some(t) = t {
+            map.insert("t".into(), json!(t));
+        }
+    }
+    Found {
+        offset,
+        json,
+        text: format!("{offset:>8}  {text}"),
+    }
+}
+
+fn describe_downlink(frame: &Downlink) -> (Value, String) {
+    match frame {
+        Downlink::Imu(f) => (
+            json!({"frame": "imu", "accel": f.accel, "gyro": f.gyro, "count": f.seq}),
+            format!(
+                "imu       accel {:?} gyro {:?} count {}",
+                f.accel, f.gyro, f.seq
+            ),
+        ),
+        Downlink::Encoders(f) => (
+            json!({"frame": "encoders", "ticks": f.ticks, "count": f.seq}),
+            format!("encoders  ticks {:?} count {}", f.ticks, f.seq),
+        ),
+        Downlink::Battery(f) => (
+            json!({"frame": "battery", "centivolts": f.centivolts, "percent": f.percent, "count": f.seq}),
+            format!(
+                "battery   {}.{:02} V {} % count {}",
+                f.centivolts / 100,
+                f.centivolts % 100,
+                f.percent,
+                f.seq
+            ),
+        ),
+        Downlink::Reply(r) => {
+            // Code 0x20 (the pending angle) is signed.
+            let value = if r.code == 0x20 {
+                json!(r.value as i32)
+            } else {
+                json!(r.value)
+            };
+            (
+                json!({"frame": "reply", "code": r.code, "value": value}),
+                format!("reply     code 0x{:02X} value {value}", r.code),
+            )
+        }
+    }
+}
+
+fn describe_uplink(command: &Command) -> (Value, String) {
+    match command {
+        Command::Velocity(v) => (
+            json!({"frame": "velocity", "x": v.x, "y": v.y, "z": v.z, "angle": false}),
+            format!("velocity  x {} y {} z {}", v.x, v.y, v.z),
+        ),
+        Command::Turn(t) => (
+            json!({"frame": "velocity", "x": t.x, "y": t.y, "z": t.deci_degrees, "angle": true}),
+            format!(
+                "velocity  x {} y {} turn {} (0.1°, added up)",
+                t.x, t.y, t.deci_degrees
+            ),
+        ),
+        Command::Motors(m) => {
+            let closed = m.control == chassis_protocol::MotorLoop::Closed;
+            (
+                json!({"frame": "motors", "closed_loop": closed, "speeds": m.values}),
+                format!(
+                    "motors    {} {:?}",
+                    if closed { "closed loop" } else { "open loop" },
+                    m.values
+                ),
+            )
+        }
+        Command::Setting(Setting::Action(a)) => (
+            json!({"frame": "action", "action": a.number()}),
+            format!("action    {} ({a:?})", a.number()),
+        ),
+        Command::Setting(Setting::Write(w)) => (
+            json!({"frame": "write", "code": w.register().code(), "value": w.value()}),
+            format!(
+                "write     code 0x{:02X} value {}",
+                w.register().code(),
+                w.value()
+            ),
+        ),
+        Command::Setting(Setting::Read(r)) => (
+            json!({"frame": "read", "code": r.read_code()}),
+            format!("read      code 0x{:02X} ({r:?})", r.read_code()),
+        ),
+        Command::Setting(Setting::Raw { code, value, .. }) => (
+            json!({"frame": "setting", "code": code, "value": value}),
+            format!("setting   code 0x{code:02X} value {value} (not in the spec)"),
+        ),
+    }
+}

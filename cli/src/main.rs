@@ -1,0 +1,210 @@
+//! `chassis`: the command-line tool for the chassis motor-controller board. Decode captures,
+//! encode frames, talk to a board over a serial port, serve a simulated one. Every bad input
+//! (a missing port, a file that is not there, odd hex, a value out of range, a silent board)
+//! is one line on stderr and a non-zero exit.
+
+mod decode;
+mod device;
+mod encode;
+mod monitor;
+mod names;
+mod sim;
+mod value;
+
+use clap::{Parser, Subcommand};
+use names::RegisterName;
+use std::io::{Read, Write};
+use std::process::ExitCode;
+
+/// The chassis motor-controller board's command-line tool.
+#[derive(Debug, Parser)]
+#[command(name = "chassis", version, about)]
+struct Cli {
+    /// The board's serial port (115 200 8N1), for the commands that talk to a board.
+    #[arg(long, global = true, value_name = "PATH")]
+    port: Option<String>,
+    #[command(subcommand)]
+    command: Cmd,
+}
+
+#[derive(Debug, Subcommand)]
+enum Cmd {
+    /// Decode a capture: one JSON object per frame per line, a summary on stderr.
+    Decode {
+        /// The capture file ("-" or nothing: standard input).
+        file: Option<String>,
+        /// The master → board direction.
+        #[arg(long)]
+        uplink: bool,
+        /// How the capture is written.
+        #[arg(long, value_enum, default_value = "raw")]
+        input: decode::Input,
+        /// How frames are written.
+        #[arg(long, value_enum, default_value = "json")]
+        format: decode::Format,
+    },
+    /// Print a master → board frame's bytes as hex.
+    Encode {
+        #[command(subcommand)]
+        frame: encode::Frame,
+    },
+    /// Read a register (each read verified: two replies must agree).
+    Get {
+        /// The register.
+        register: RegisterName,
+    },
+    /// Write a register and read it back (battery-range: FULL CUTOFF, 0.01 V each).
+    Set {
+        /// The register.
+        register: RegisterName,
+        /// The value (decimal or 0x hex).
+        value: String,
+        /// battery-range only: the cut-off voltage.
+        cutoff: Option<String>,
+    },
+    /// Every register as JSON; or save them to a file, or restore them from one.
+    Settings {
+        /// Write the settings to FILE.
+        #[arg(long, value_name = "FILE", conflicts_with = "restore")]
+        save: Option<String>,
+        /// Write the settings in FILE to the board (never starts a gyro calibration).
+        #[arg(long, value_name = "FILE")]
+        restore: Option<String>,
+    },
+    /// Store the current settings in the board's flash.
+    Save,
+    /// Calibrate the gyro again (30 s: put the chassis down, then keep it still).
+    CalibrateGyro,
+    /// Drive at a velocity for a while, then stop.
+    Drive {
+        #[command(flatten)]
+        axes: encode::Axes,
+        /// How long, in seconds.
+        #[arg(long = "for", value_name = "SECONDS")]
+        seconds: f64,
+    },
+    /// Turn by DEGREES (sent once: the board adds turns up) and wait until it is done.
+    Turn {
+        /// Degrees, positive or negative.
+        #[arg(allow_hyphen_values = true)]
+        degrees: f64,
+    },
+    /// A live view of the telemetry; with --drive, keys drive the chassis.
+    Monitor {
+        /// Drive with the keys (arrows / WASD, space stops, t turns 90° once).
+        #[arg(long)]
+        drive: bool,
+        /// The speed the keys drive at.
+        #[arg(long, default_value = "300")]
+        speed: String,
+    },
+    /// Serve a simulated board (prints where).
+    Sim {
+        /// On a new pseudo-terminal (prints its path).
+        #[arg(long, conflicts_with = "tcp")]
+        pty: bool,
+        /// On a TCP address, e.g. 127.0.0.1:7878 (what the QEMU firmware connects to).
+        #[arg(long, value_name = "ADDR")]
+        tcp: Option<String>,
+        /// Line errors per byte, a third each dropped, changed and added (e.g. 1e-3).
+        #[arg(long, value_name = "RATE", default_value = "0")]
+        faults: f64,
+        /// Seed of the board's noise and faults.
+        #[arg(long, default_value = "1")]
+        seed: u64,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("chassis: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn port(cli_port: Option<&str>) -> Result<&str, String> {
+    cli_port.ok_or_else(|| "this command talks to a board: give its serial port with --port PATH (or try `chassis sim --pty`)".to_string())
+}
+
+fn run(cli: Cli) -> Result<(), String> {
+    let p = cli.port.as_deref();
+    match cli.command {
+        Cmd::Decode {
+            file,
+            uplink,
+            input,
+            format,
+        } => {
+            let data = match file.as_deref() {
+                None | Some("-") => {
+                    let mut data = Vec::new();
+                    std::io::stdin()
+                        .read_to_end(&mut data)
+                        .map_err(|e| format!("standard input: {e}"))?;
+                    data
+                }
+                Some(path) => {
+                    std::fs::read(path).map_err(|e| format!("cannot read {path}: {e}"))?
+                }
+            };
+            let capture = decode::read_capture(&data, input)?;
+            let decoded = decode::decode(&capture, uplink);
+            let stdout = std::io::stdout();
+            let mut out = std::io::BufWriter::new(stdout.lock());
+            for found in &decoded.frames {
+                let line = match format {
+                    decode::Format::Json => found.json.to_string(),
+                    decode::Format::Text => found.text.clone(),
+                };
+                if writeln!(out, "{line}").is_err() {
+                    // A closed pipe (`| head`): stop quietly.
+                    return Ok(());
+                }
+            }
+            let _ = out.flush();
+            eprintln!("chassis decode: {}", decoded.summary);
+            Ok(())
+        }
+        Cmd::Encode { frame } => {
+            println!("{}", encode::hex(&encode::encode(&frame)?));
+            Ok(())
+        }
+        Cmd::Get { register } => device::get(port(p)?, register),
+        Cmd::Set {
+            register,
+            value,
+            cutoff,
+        } => device::set(port(p)?, register, &value, cutoff.as_deref()),
+        Cmd::Settings { save, restore } => {
+            device::settings(port(p)?, save.as_deref(), restore.as_deref())
+        }
+        Cmd::Save => device::save(port(p)?),
+        Cmd::CalibrateGyro => device::calibrate_gyro(port(p)?),
+        Cmd::Drive { axes, seconds } => {
+            let (x, y, z) = axes.values()?;
+            device::drive(port(p)?, chassis_protocol::Velocity::new(x, y, z), seconds)
+        }
+        Cmd::Turn { degrees } => device::turn(port(p)?, degrees),
+        Cmd::Monitor { drive, speed } => {
+            let speed = value::parse_i32(&speed, "speed", 1, 65_535)?;
+            monitor::run(port(p)?, drive, speed)
+        }
+        Cmd::Sim {
+            pty,
+            tcp,
+            faults,
+            seed,
+        } => {
+            let faults = sim::faults(faults)?;
+            match (pty, tcp) {
+                (true, _) => sim::pty(seed, faults),
+                (false, Some(addr)) => sim::tcp(&addr, seed, faults),
+                (false, None) => Err("sim: give --pty or --tcp ADDR".into()),
+            }
+        }
+    }
+}
