@@ -33,3 +33,15 @@ fn spliced_cut_of_frames_of_both_streams() {
     };
     assert_eq!(check_recovery(&splice), Ok(()));
 }
+
+/// `spliced`, CI run of 2026-11-22 (the repeatable run after the parser's fast paths).
+#[test]
+fn spliced_reply_after_cut() {
+    let splice = Splice {
+        seed: 2_821_266_740_684_980_224,
+        at: 16_167,
+        cut: 217,
+        garbage: &[0, 96],
+    };
+    assert_eq!(check_recovery(&splice), Ok(()));
+}

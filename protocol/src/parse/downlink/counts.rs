@@ -57,6 +57,8 @@ struct Step {
 pub struct Counts {
     /// Bit `i`: stream `i` has a count.
     known: u8,
+    /// Bit `i`: stream `i`'s count was continued by a frame of its own (see [`Counts::rel`]).
+    confirmed: u8,
     last: [u8; 3],
     steps: [[Step; STEPS]; 3],
     /// Bytes received since each stream's last frame (saturating).
@@ -80,6 +82,7 @@ impl Counts {
     pub const fn new() -> Self {
         Counts {
             known: 0,
+            confirmed: 0,
             last: [0; 3],
             steps: [[Step { delta: 0, hits: 0 }; STEPS]; 3],
             since: [0; 3],
@@ -132,10 +135,24 @@ impl Counts {
 
     /// How `count` relates to `stream`'s last count, for a frame that starts `extra` bytes after
     /// the bytes counted so far.
+    ///
+    /// A count no frame of its stream has continued yet (the stream's first frame since the
+    /// counts were forgotten) is a guess: it may be a false frame's, passed over in a chain
+    /// while the line was damaged. A count far from a guess is no evidence against its frame,
+    /// so it is [`Rel::Unknown`], as if the guess had not been made (the battery's count, once a
+    /// second, would otherwise hold a false count for a whole second).
     pub fn rel(&self, stream: Stream, count: u8, extra: usize) -> Rel {
         if !self.knows(stream) {
             return Rel::Unknown;
         }
+        match self.rel_known(stream, count, extra) {
+            Rel::Far if self.confirmed & (1 << stream.index()) == 0 => Rel::Unknown,
+            rel => rel,
+        }
+    }
+
+    /// [`rel`](Self::rel) for a stream with a count, confirmed or not.
+    fn rel_known(&self, stream: Stream, count: u8, extra: usize) -> Rel {
         let i = stream.index();
         let last = self.last.get(i).copied().unwrap_or(0);
         let delta = count.wrapping_sub(last);
@@ -200,12 +217,25 @@ impl Counts {
         if let Some(alt) = self.alt.get_mut(i) {
             *alt = None;
         }
-        if self.known & bit != 0 && !rebased {
+        if self.known & bit == 0 {
+            self.confirmed &= !bit;
+        } else if rebased {
+            self.confirmed |= bit;
+        } else {
             let last = self.last.get(i).copied().unwrap_or(0);
             let delta = count.wrapping_sub(last);
             if let Some(steps) = self.steps.get_mut(i) {
+                let none_learnt = steps.iter().all(|s| s.hits == 0);
                 if let Some(step) = steps.iter_mut().find(|s| s.hits > 0 && s.delta == delta) {
                     step.hits = step.hits.saturating_add(1);
+                    self.confirmed |= bit;
+                } else if none_learnt && (1..=FIRST_STEP_MAX).contains(&delta) {
+                    self.confirmed |= bit;
+                    if learn {
+                        if let Some(slot) = steps.first_mut() {
+                            *slot = Step { delta, hits: 1 };
+                        }
+                    }
                 } else if learn && (1..=127).contains(&delta) {
                     // Replace the least seen step.
                     if let Some(slot) = steps.iter_mut().min_by_key(|s| s.hits) {
@@ -319,16 +349,34 @@ mod tests {
         let mut c = Counts::new();
         assert_eq!(c.rel(Stream::Encoders, 10, 0), Rel::Unknown);
         c.take(Stream::Encoders, 10, true);
-        // No step learnt yet: 1..=4 on continues.
+        // No step learnt yet: 1..=4 on continues; a count far from a first one, which nothing
+        // has confirmed, says nothing.
         assert_eq!(c.rel(Stream::Encoders, 14, 0), Rel::Continues);
-        assert_eq!(c.rel(Stream::Encoders, 30, 0), Rel::Far);
+        assert_eq!(c.rel(Stream::Encoders, 30, 0), Rel::Unknown);
         c.take(Stream::Encoders, 14, true);
-        // A tick of 4 per frame: learnt.
+        // A tick of 4 per frame: learnt, and the count confirmed.
         assert_eq!(c.rel(Stream::Encoders, 18, 0), Rel::Continues);
         assert_eq!(c.rel(Stream::Encoders, 15, 0), Rel::Far);
+        assert_eq!(c.rel(Stream::Encoders, 30, 0), Rel::Far);
         // Two frames lost need the bytes to have held them.
         assert_eq!(c.rel(Stream::Encoders, 26, 0), Rel::Far);
         assert_eq!(c.rel(Stream::Encoders, 26, 130), Rel::Near);
+    }
+
+    #[test]
+    fn a_count_is_a_guess_until_its_stream_continues_it() {
+        let mut c = Counts::new();
+        c.take(Stream::Battery, 232, false);
+        assert_eq!(c.rel(Stream::Battery, 9, 0), Rel::Unknown);
+        // Taken as a stream's first again: still a guess.
+        c.take(Stream::Battery, 9, false);
+        assert_eq!(c.rel(Stream::Battery, 200, 0), Rel::Unknown);
+        c.take(Stream::Battery, 10, false);
+        assert_eq!(c.rel(Stream::Battery, 200, 0), Rel::Far);
+        // Forgotten and seen again: a guess again.
+        c.forget();
+        c.take(Stream::Battery, 50, false);
+        assert_eq!(c.rel(Stream::Battery, 200, 0), Rel::Unknown);
     }
 
     #[test]

@@ -62,6 +62,9 @@
 //! * **A quiet line is time, not amnesia** ([`DownlinkParser::quiet`]): it widens every
 //!   stream's count window by the frames the time could hold (the board pauses telemetry
 //!   while settings are made); the count check never goes away.
+//! * **A count is a guess until its stream continues it**: a count far from one that no frame
+//!   of its own stream has continued yet (a false frame passed over in a chain while the line
+//!   was damaged, then a second with no battery frame to correct it) counts as unknown, not far.
 //! * After [`FORGET_AFTER`] bytes without a frame taken, every count is forgotten (the board
 //!   may have restarted): nothing can hold the parser off for ever.
 //!
