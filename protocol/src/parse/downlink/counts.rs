@@ -69,6 +69,9 @@ pub struct Counts {
     /// next frame continues it instead, the board really moved its count on, and the count
     /// follows it.
     alt: [Option<u8>; 3],
+    /// Per stream, how far the far count in `alt` was from the count before it: a step the
+    /// board really takes once the stream's next frame continues `alt`.
+    alt_step: [u8; 3],
 }
 
 impl Default for Counts {
@@ -88,6 +91,7 @@ impl Counts {
             since: [0; 3],
             quiet_ms: [0; 3],
             alt: [None; 3],
+            alt_step: [0; 3],
         }
     }
 
@@ -220,7 +224,19 @@ impl Counts {
         if self.known & bit == 0 {
             self.confirmed &= !bit;
         } else if rebased {
+            // The far count was real: the step to it is one the board takes (a shared counter
+            // steps the encoders by 6 when a battery frame came between).
             self.confirmed |= bit;
+            let delta = self.alt_step.get(i).copied().unwrap_or(0);
+            if learn && (1..=127).contains(&delta) {
+                if let Some(steps) = self.steps.get_mut(i) {
+                    if !steps.iter().any(|s| s.hits > 0 && s.delta == delta) {
+                        if let Some(slot) = steps.iter_mut().min_by_key(|s| s.hits) {
+                            *slot = Step { delta, hits: 1 };
+                        }
+                    }
+                }
+            }
         } else {
             let last = self.last.get(i).copied().unwrap_or(0);
             let delta = count.wrapping_sub(last);
@@ -279,6 +295,9 @@ impl Counts {
         }
         if let Some(alt) = self.alt.get_mut(i) {
             *alt = Some(count);
+        }
+        if let Some(alt_step) = self.alt_step.get_mut(i) {
+            *alt_step = count.wrapping_sub(self.last.get(i).copied().unwrap_or(count));
         }
         let step = self
             .steps
