@@ -321,7 +321,7 @@ pub struct DriverCore {
     stalled_at: Option<u64>,
 }
 
-// RAM budget of the core (the parser 204 bytes with its 96-byte window, the request in
+// RAM budget of the core (the parser 208 bytes with its 96-byte window, the request in
 // progress 104, latest frames, stream figures, timers): 680 bytes on 64-bit hosts.
 const _: () = assert!(
     core::mem::size_of::<DriverCore>() <= 688,
