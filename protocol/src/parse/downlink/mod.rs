@@ -39,6 +39,11 @@
 //! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it) |
 //! | 12 | Hunting | a reply nobody awaits | never |
 //! | 13 | Hunting | telemetry, count far | when its own stream's next three frames in the chain move on from it in step (the board restarted its counts) |
+//! | 14 | Hunting, inside a frame rejected on a boundary | telemetry whose last bytes are a whole frame of another stream, whose count fits that stream | never (the scan reaches the inner frame next) |
+//!
+//! *Inside a frame rejected on a boundary* (row 14): a candidate that starts within the length
+//! the rejected frame's header promised, less [`MAX_DROPPED`] bytes it may have lost. A real
+//! frame starts there only if the rejected one lost more bytes than that.
 //!
 //! *The chain vouches* ([`rules::Chain`]) when the frames right after the candidate, back to
 //! back, reach one whose count continues (or is near) its stream's count, counting the
@@ -100,6 +105,10 @@ const IN_STEP: u8 = 3;
 
 /// Junk bytes a candidate whose count continues exactly may have before its chain.
 const MAX_GAP: usize = 2;
+
+/// Bytes a frame rejected on a boundary is taken to have lost at most, for row 14: real frames
+/// start no earlier than its header's length less this.
+pub const MAX_DROPPED: usize = 2;
 
 /// How sure the parser is of where frames start.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -254,6 +263,8 @@ pub struct DownlinkParser {
     /// judging it has needed more (0: none known; always 0 while `drain`): until the last one, a
     /// byte is only stored.
     missing: u8,
+    /// Start positions still inside the frame last rejected on a boundary (row 14).
+    shadow: u8,
     stats: DownlinkStats,
 }
 
@@ -281,6 +292,7 @@ impl DownlinkParser {
             drain: false,
             since_frame: 0,
             missing: 0,
+            shadow: 0,
             stats: DownlinkStats::new(),
         }
     }
@@ -451,6 +463,7 @@ impl DownlinkParser {
         let frame = self.run(true);
         if frame.is_none() {
             self.counts.quiet(ms);
+            self.shadow = 0;
             if self.lock == Lock::Hunting {
                 self.lock = Lock::Tentative;
             }
@@ -562,6 +575,13 @@ impl DownlinkParser {
                 clean: !holds_a_frame_start(reply.encode().get(2..).unwrap_or(&[])),
             },
             Downlink::Reply(_) => Class::Unexpected,
+            _ if self.lock == Lock::Hunting
+                && self.shadow > 0
+                && at == 0
+                && self.nests_a_frame(frame) =>
+            {
+                Class::Nested
+            }
             _ => match (frame.kind(), frame.seq()) {
                 (Kind::Telemetry(stream), Some(seq)) => match self.counts.rel(stream, seq, at) {
                     Rel::Continues | Rel::Near
@@ -578,6 +598,31 @@ impl DownlinkParser {
                 _ => Class::Unexpected,
             },
         }
+    }
+
+    /// Whether the telemetry candidate `frame` at the front of the window ends with a whole
+    /// frame of another stream whose count continues (or is near) that stream's.
+    fn nests_a_frame(&self, frame: &Downlink) -> bool {
+        let (Kind::Telemetry(outer), Some(seq)) = (frame.kind(), frame.seq()) else {
+            return false;
+        };
+        let len = frame.kind().len();
+        let bytes = self.buf.as_slice();
+        Stream::ALL.iter().any(|inner| {
+            let inner_kind = Kind::Telemetry(*inner);
+            let Some(off) = len.checked_sub(inner_kind.len()).filter(|off| *off > 0) else {
+                return false;
+            };
+            *inner != outer
+                && matches!(
+                    bytes.get(off..off.saturating_add(2)),
+                    Some([a, b]) if Kind::from_header(*a, *b) == Some(inner_kind)
+                )
+                && matches!(
+                    self.counts.rel(*inner, seq, off),
+                    Rel::Continues | Rel::Near
+                )
+        })
     }
 
     /// Whether `seq` would continue (or be near) a stream other than `stream`.
@@ -758,8 +803,19 @@ impl DownlinkParser {
 
     /// Drops the candidate's first byte and goes hunting.
     fn reject(&mut self) {
+        // A frame rejected on a boundary: the start positions inside it (row 14).
+        let shadow = match (self.lock, self.buf.as_slice()) {
+            (Lock::Locked | Lock::Tentative, [first, second, ..]) => {
+                Kind::from_header(*first, *second)
+                    .map(|kind| kind.len().saturating_sub(MAX_DROPPED.saturating_add(1)))
+            }
+            _ => None,
+        };
         self.buf.drop_front(1);
         self.discard();
+        if let Some(shadow) = shadow {
+            self.shadow = u8::try_from(shadow).unwrap_or(u8::MAX);
+        }
     }
 
     /// Counts one byte thrown away (already out of the window, or never in it).
@@ -774,6 +830,9 @@ impl DownlinkParser {
 
     /// `n` bytes left the window.
     fn consumed(&mut self, n: usize) {
+        self.shadow = self
+            .shadow
+            .saturating_sub(u8::try_from(n).unwrap_or(u8::MAX));
         self.counts.bytes(n);
         self.since_frame = self
             .since_frame
@@ -808,6 +867,7 @@ impl DownlinkParser {
         self.buf.drop_front(len);
         self.counts.bytes(len);
         self.since_frame = 0;
+        self.shadow = 0;
         self.stats.count_frame(frame.kind());
         match (frame.kind(), frame.seq(), frame) {
             (Kind::Telemetry(stream), Some(seq), _) if !believed => self.counts.skip(stream, seq),
@@ -837,6 +897,7 @@ impl DownlinkParser {
         self.buf.drop_front(len);
         self.counts.bytes(len);
         self.since_frame = 0;
+        self.shadow = 0;
         self.stats.count_frame(Kind::Telemetry(stream));
         self.counts.take(stream, seq, true);
         if self.lock == Lock::Hunting {

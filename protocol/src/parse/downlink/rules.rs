@@ -26,6 +26,12 @@ pub enum Class {
     },
     /// A reply the master is not waiting for (or a parser told nothing).
     Unexpected,
+    /// Found while hunting inside a frame rejected on a boundary (see the module docs, row
+    /// 14): telemetry whose last bytes are a whole frame of another stream, ending on the same
+    /// count byte, whose count fits that stream. The damaged frame's tail with a header in its
+    /// payload, then the real frame: both cannot be real, and the inner one, which starts with
+    /// its own header, is judged on its own when the scan reaches it.
+    Nested,
 }
 
 /// How a chain of frames after the candidate must vouch for it.
@@ -105,6 +111,10 @@ pub const fn need(lock: Lock, class: Class) -> Need {
         // 13. Hunting, a far count: its own stream's next three frames must move on from it in
         //     step (a board that restarted its counts).
         (Lock::Hunting, Class::Far) => Need::Chain(Chain::Restart),
+        // 14. Hunting inside a frame rejected on a boundary, a whole frame of another stream
+        //     fills the candidate's tail, its count fitting: never (the scan reaches the inner
+        //     frame next). Only ever found while hunting.
+        (_, Class::Nested) => Need::Never,
     }
 }
 
@@ -189,6 +199,11 @@ mod tests {
     #[test]
     fn row12_hunting_never_takes_a_reply_nobody_waits_for() {
         assert_eq!(need(Hunting, Class::Unexpected), Need::Never);
+    }
+
+    #[test]
+    fn row14_a_frame_whose_tail_is_another_streams_frame_inside_a_rejected_one_is_never_taken() {
+        assert_eq!(need(Hunting, Class::Nested), Need::Never);
     }
 
     #[test]

@@ -227,3 +227,51 @@ fn never_stuck_on_any_single_byte_value() {
         assert!(seqs(&out).contains(&1), "stuck after {value:#04x}");
     }
 }
+
+/// Row 14. One counter shared by all streams; IMU frame 19 loses its count byte, and its gyro
+/// Y reads `FF FA`: its last four bytes and encoder frame 20 make a 15-byte "IMU frame" whose
+/// count (20) is near the IMU's (18) and continues the encoders' (15), and IMU 21 continues it
+/// too. It starts inside the frame rejected on the boundary, and its tail is a whole encoder
+/// frame whose count fits: never taken; the encoder frame is.
+#[test]
+fn row14_a_damaged_frames_tail_with_a_header_does_not_swallow_the_next_frame() {
+    let imu = |seq: u8| Imu {
+        accel: [1, -2, 16_384],
+        gyro: [0, -6, 0x0102],
+        seq,
+    };
+    let enc = |seq: u8| Encoders {
+        ticks: [10, 20, 30, 40],
+        seq,
+    };
+    let mut p = DownlinkParser::new();
+    assert_eq!(p.quiet(1), None);
+    let mut wire = Vec::new();
+    let mut sent = Vec::new();
+    for seq in 1..=40u8 {
+        let frame = if seq % 5 == 0 {
+            Downlink::Encoders(enc(seq))
+        } else {
+            Downlink::Imu(imu(seq))
+        };
+        let bytes = frame.encode();
+        if seq == 19 {
+            // The count byte lost.
+            wire.extend_from_slice(&bytes[..bytes.len() - 1]);
+        } else {
+            wire.extend_from_slice(&bytes);
+            sent.push(frame);
+        }
+    }
+    let mut out = feed(&mut p, &wire);
+    out.extend(drain_quiet(&mut p, 1));
+    // (Without row 14: `Imu { accel: [258, -5, 10], gyro: [20, 30, 40], seq: 20 }`.)
+    if let Some(false_frame) = out.iter().find(|f| !sent.contains(f)) {
+        panic!("false frame {false_frame:?}");
+    }
+    assert!(out.contains(&Downlink::Encoders(enc(20))));
+    // Everything after the damaged frame comes out.
+    for frame in sent.iter().filter(|f| f.seq() > Some(19)) {
+        assert!(out.contains(frame), "{frame:?} lost");
+    }
+}
