@@ -40,6 +40,7 @@
 //! | 12 | Hunting | a reply nobody awaits | never |
 //! | 13 | Hunting | telemetry, count far | when its own stream's next three frames in the chain move on from it in step (the board restarted its counts) |
 //! | 14 | Hunting, inside a frame rejected on a boundary | telemetry whose last bytes are a whole frame of another stream, whose count fits that stream | never (the scan reaches the inner frame next) |
+//! | 15 | any | telemetry, count far, its last two bytes a telemetry header (a cut frame running into the next one) | never |
 //!
 //! *Inside a frame rejected on a boundary* (row 14): a candidate that starts within the length
 //! the rejected frame's header promised, less [`MAX_DROPPED`] bytes it may have lost. A real
@@ -593,11 +594,22 @@ impl DownlinkParser {
                     Rel::Continues => Class::Continues,
                     Rel::Near => Class::Near,
                     Rel::Unknown => Class::First,
+                    Rel::Far if self.ends_with_a_header(frame, at) => Class::Cut,
                     Rel::Far => Class::Far,
                 },
                 _ => Class::Unexpected,
             },
         }
+    }
+
+    /// Whether the last two bytes of the candidate `frame`, starting `at` bytes into the window,
+    /// are a telemetry header.
+    fn ends_with_a_header(&self, frame: &Downlink, at: usize) -> bool {
+        let end = at.saturating_add(frame.kind().len());
+        matches!(
+            self.buf.as_slice().get(end.saturating_sub(2)..end),
+            Some([a, b]) if matches!(Kind::from_header(*a, *b), Some(Kind::Telemetry(_)))
+        )
     }
 
     /// Whether the telemetry candidate `frame` at the front of the window ends with a whole

@@ -26,6 +26,10 @@ pub enum Class {
     },
     /// A reply the master is not waiting for (or a parser told nothing).
     Unexpected,
+    /// Telemetry whose count is far and whose last two bytes are a telemetry header: a frame
+    /// cut short that runs into the next frame's header, its "count" the header's second byte
+    /// (`FA`, `FB`, `FC` are consecutive, so two such cuts in a row look like a count moving on).
+    Cut,
     /// Found while hunting inside a frame rejected on a boundary (see the module docs, row
     /// 14): telemetry whose last bytes are a whole frame of another stream, ending on the same
     /// count byte, whose count fits that stream. The damaged frame's tail with a header in its
@@ -115,6 +119,8 @@ pub const fn need(lock: Lock, class: Class) -> Need {
         //     fills the candidate's tail, its count fitting: never (the scan reaches the inner
         //     frame next). Only ever found while hunting.
         (_, Class::Nested) => Need::Never,
+        // 15. A far count that is a header's second byte (the frame ends with a header): never.
+        (_, Class::Cut) => Need::Never,
     }
 }
 
@@ -204,6 +210,13 @@ mod tests {
     #[test]
     fn row14_a_frame_whose_tail_is_another_streams_frame_inside_a_rejected_one_is_never_taken() {
         assert_eq!(need(Hunting, Class::Nested), Need::Never);
+    }
+
+    #[test]
+    fn row15_a_far_count_that_is_the_next_headers_second_byte_is_never_taken() {
+        for lock in [Hunting, Tentative, Locked] {
+            assert_eq!(need(lock, Class::Cut), Need::Never);
+        }
     }
 
     #[test]
