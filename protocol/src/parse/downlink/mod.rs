@@ -460,12 +460,19 @@ impl DownlinkParser {
     /// A complete frame that waits for what follows it is judged with the quiet as what
     /// follows; an incomplete one is thrown away. Then the next byte is taken to start a frame
     /// (*Tentative*), and every stream's count window widens by the frames `ms` could hold.
+    ///
+    /// Unless the line lost a stretch of bytes: a frame that started on a boundary and misses
+    /// more than [`MAX_DROPPED`] bytes when the line goes quiet lost its tail, and the bytes
+    /// lost may run past the quiet stretch (a UART overrun drops whatever arrives while it
+    /// lasts), so the next burst may start in the middle of a frame. The parser then goes on
+    /// hunting. (A byte or two missing is noise inside the frame: the next burst is aligned.)
     pub fn quiet(&mut self, ms: u32) -> Option<Downlink> {
+        let cut = self.lock != Lock::Hunting && usize::from(self.front_missing()) > MAX_DROPPED;
         let frame = self.run(true);
         if frame.is_none() {
             self.counts.quiet(ms);
             self.shadow = 0;
-            if self.lock == Lock::Hunting {
+            if self.lock == Lock::Hunting && !cut {
                 self.lock = Lock::Tentative;
             }
         }

@@ -180,11 +180,15 @@ fn quiet_completes_a_frame_and_drops_a_partial_one() {
     assert_eq!(p.quiet(1), None);
     assert_eq!(p.stats().discarded, 7);
     assert_eq!(p.lock(), Lock::Tentative);
-    // Partial frames are dropped at a quiet line.
+    // Partial frames are dropped at a quiet line. One that started on a boundary and misses
+    // more than two bytes lost a stretch that may run past the quiet: the parser hunts on.
     assert_eq!(feed(&mut p, &[0x23, 0x01, 0x00]), vec![]);
     assert_eq!(p.quiet(1), None);
     assert_eq!(p.buffered(), 0);
-    // After a quiet line, the awaited reply comes out on its last byte.
+    assert_eq!(p.lock(), Lock::Hunting);
+    // After the next quiet line, the awaited reply comes out on its last byte.
+    assert_eq!(p.quiet(1), None);
+    assert_eq!(p.lock(), Lock::Tentative);
     let reply = Reply::new(Register::PendingAngle, 0);
     p.expect_reply(Some(Register::PendingAngle));
     assert_eq!(feed(&mut p, &reply.encode()), vec![Downlink::Reply(reply)]);
@@ -316,4 +320,45 @@ fn row15_a_cut_frame_running_into_the_next_header_is_not_a_new_count() {
     for frame in after.iter().skip(1) {
         assert!(out.contains(frame), "{frame:?} lost");
     }
+}
+
+/// A 32-byte dropout across a quiet stretch: IMU frame 5 loses all but 6 bytes, and the next
+/// burst starts inside IMU frame 7, whose last 7 bytes read like a battery frame (gyro X is
+/// `FF FC`) with a count (7) that continues the battery's (6). The incomplete frame at the
+/// quiet line says the line lost a stretch: the parser hunts on, and the fragment that fills
+/// the burst up to the next quiet line is not taken.
+#[test]
+fn a_dropout_across_a_quiet_line_leaves_the_parser_hunting() {
+    let imu = |seq: u8| {
+        Downlink::Imu(Imu {
+            accel: [1, 2, 16_384],
+            gyro: [-4, 3, 4],
+            seq,
+        })
+    };
+    let battery = Downlink::Battery(Battery {
+        centivolts: 1_200,
+        percent: 90,
+        seq: 6,
+    });
+    let mut p = DownlinkParser::new();
+    assert_eq!(p.quiet(1), None);
+    let mut out = Vec::new();
+    for frame in [imu(1), imu(2), battery, imu(3), imu(4)] {
+        out.extend(feed(&mut p, &frame.encode()));
+    }
+    out.extend(drain_quiet(&mut p, 2));
+    assert_eq!(out.len(), 5);
+    assert_eq!(feed(&mut p, &imu(5).encode()[..6]), vec![]);
+    assert_eq!(drain_quiet(&mut p, 8), vec![]);
+    assert_eq!(feed(&mut p, &imu(7).encode()[8..]), vec![]);
+    assert_eq!(
+        drain_quiet(&mut p, 8),
+        vec![],
+        "the burst's tail taken for a frame"
+    );
+    let mut out = feed(&mut p, &imu(8).encode());
+    out.extend(feed(&mut p, &imu(9).encode()));
+    out.extend(drain_quiet(&mut p, 8));
+    assert_eq!(out, vec![imu(8), imu(9)]);
 }
