@@ -223,39 +223,30 @@ impl Counts {
         }
         if self.known & bit == 0 {
             self.confirmed &= !bit;
-        } else if rebased {
-            // The far count was real: the step to it is one the board takes (a shared counter
-            // steps the encoders by 6 when a battery frame came between).
-            self.confirmed |= bit;
-            let delta = self.alt_step.get(i).copied().unwrap_or(0);
-            if learn && (1..=127).contains(&delta) {
-                if let Some(steps) = self.steps.get_mut(i) {
-                    if !steps.iter().any(|s| s.hits > 0 && s.delta == delta) {
-                        if let Some(slot) = steps.iter_mut().min_by_key(|s| s.hits) {
-                            *slot = Step { delta, hits: 1 };
-                        }
-                    }
-                }
-            }
         } else {
-            let last = self.last.get(i).copied().unwrap_or(0);
-            let delta = count.wrapping_sub(last);
+            // Re-based: the far count was real, and the step to it is one the board takes (a
+            // shared counter steps the encoders by 6 when a battery frame came between).
+            let delta = if rebased {
+                self.alt_step.get(i).copied().unwrap_or(0)
+            } else {
+                count.wrapping_sub(self.last.get(i).copied().unwrap_or(0))
+            };
             if let Some(steps) = self.steps.get_mut(i) {
                 let none_learnt = steps.iter().all(|s| s.hits == 0);
                 if let Some(step) = steps.iter_mut().find(|s| s.hits > 0 && s.delta == delta) {
-                    step.hits = step.hits.saturating_add(1);
+                    if !rebased {
+                        step.hits = step.hits.saturating_add(1);
+                    }
                     self.confirmed |= bit;
-                } else if none_learnt && (1..=FIRST_STEP_MAX).contains(&delta) {
-                    self.confirmed |= bit;
-                    if learn {
-                        if let Some(slot) = steps.first_mut() {
+                } else {
+                    if rebased || (none_learnt && (1..=FIRST_STEP_MAX).contains(&delta)) {
+                        self.confirmed |= bit;
+                    }
+                    if learn && (1..=127).contains(&delta) {
+                        // Replace the least seen step.
+                        if let Some(slot) = steps.iter_mut().min_by_key(|s| s.hits) {
                             *slot = Step { delta, hits: 1 };
                         }
-                    }
-                } else if learn && (1..=127).contains(&delta) {
-                    // Replace the least seen step.
-                    if let Some(slot) = steps.iter_mut().min_by_key(|s| s.hits) {
-                        *slot = Step { delta, hits: 1 };
                     }
                 }
             }

@@ -622,26 +622,29 @@ impl DownlinkParser {
     /// Whether the telemetry candidate `frame` at the front of the window ends with a whole
     /// frame of another stream whose count continues (or is near) that stream's.
     fn nests_a_frame(&self, frame: &Downlink) -> bool {
-        let (Kind::Telemetry(outer), Some(seq)) = (frame.kind(), frame.seq()) else {
+        let (Kind::Telemetry(_), Some(seq)) = (frame.kind(), frame.seq()) else {
             return false;
         };
         let len = frame.kind().len();
-        let bytes = self.buf.as_slice();
-        Stream::ALL.iter().any(|inner| {
-            let inner_kind = Kind::Telemetry(*inner);
-            let Some(off) = len.checked_sub(inner_kind.len()).filter(|off| *off > 0) else {
-                return false;
-            };
-            *inner != outer
-                && matches!(
-                    bytes.get(off..off.saturating_add(2)),
-                    Some([a, b]) if Kind::from_header(*a, *b) == Some(inner_kind)
-                )
-                && matches!(
-                    self.counts.rel(*inner, seq, off),
-                    Rel::Continues | Rel::Near
-                )
-        })
+        let bytes = self.buf.as_slice().get(..len).unwrap_or(&[]);
+        // (A frame of the same stream has the same length: only another stream's ends there.)
+        bytes
+            .windows(2)
+            .enumerate()
+            .skip(1)
+            .any(|(off, pair)| match pair {
+                [a, b] => match Kind::from_header(*a, *b) {
+                    Some(Kind::Telemetry(inner)) => {
+                        Kind::Telemetry(inner).len() == len.saturating_sub(off)
+                            && matches!(
+                                self.counts.rel(inner, seq, off),
+                                Rel::Continues | Rel::Near
+                            )
+                    }
+                    _ => false,
+                },
+                _ => false,
+            })
     }
 
     /// Whether `seq` would continue (or be near) a stream other than `stream`.
