@@ -140,24 +140,25 @@ fn ensure_defmt_print() -> Result<(), String> {
     cargo(&["install", "--locked", "defmt-print"])
 }
 
+/// Cargo's arguments that name the QEMU harness binary, after `build` or `run`.
+const HARNESS: [&str; 6] = [
+    "--release",
+    "--quiet",
+    "-p",
+    "chassis-host-tests",
+    "--bin",
+    "qemu-bringup",
+];
+
 /// Boots `elf` in QEMU against the simulated chassis, through the `qemu-bringup` harness.
 fn boot(elf: &Path, args: &[&str]) -> Result<(), String> {
     ensure_qemu()?;
     ensure_defmt_print()?;
     let elf = elf.to_string_lossy().into_owned();
-    let run_args = [
-        "run",
-        "--release",
-        "--quiet",
-        "-p",
-        "chassis-host-tests",
-        "--bin",
-        "qemu-bringup",
-        "--",
-        &elf,
-    ];
     let status = Command::new(cargo_program())
-        .args(run_args)
+        .arg("run")
+        .args(HARNESS)
+        .args(["--", &elf])
         .args(args)
         .current_dir(workspace_root()?)
         .status()
@@ -178,15 +179,7 @@ pub fn demo() -> Result<(), String> {
     let board = &BOARDS[0];
     build_board(board, &[], &[])?;
     // The harness, built before the clock of the run starts.
-    cargo(&[
-        "build",
-        "--release",
-        "--quiet",
-        "-p",
-        "chassis-host-tests",
-        "--bin",
-        "qemu-bringup",
-    ])?;
+    cargo(&[&["build"][..], &HARNESS[..]].concat())?;
     eprintln!(
         "built in {:.0} s; booting the firmware\n",
         start.elapsed().as_secs_f64()
