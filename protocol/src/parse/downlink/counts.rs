@@ -390,6 +390,24 @@ mod tests {
     }
 
     #[test]
+    fn a_far_count_the_stream_then_continues_teaches_its_step() {
+        // One counter shared by all streams: the encoders usually step by 5, by 6 when a
+        // battery frame came between.
+        let mut c = Counts::new();
+        for count in [0u8, 5, 10] {
+            c.take(Stream::Encoders, count, true);
+        }
+        assert_eq!(c.rel(Stream::Encoders, 16, 0), Rel::Far);
+        // Taken on a certain boundary but not believed; the next frame continues it.
+        c.skip(Stream::Encoders, 16);
+        assert_eq!(c.rel(Stream::Encoders, 21, 0), Rel::Continues);
+        c.take(Stream::Encoders, 21, true);
+        // The step of 6 is learnt: the next such frame continues.
+        assert_eq!(c.rel(Stream::Encoders, 27, 0), Rel::Continues);
+        assert_eq!(c.rel(Stream::Encoders, 26, 0), Rel::Continues);
+    }
+
+    #[test]
     fn quiet_time_widens_but_never_removes_the_check() {
         let mut c = Counts::new();
         c.take(Stream::Imu, 200, true);
