@@ -613,10 +613,11 @@ impl DownlinkParser {
     /// are a telemetry header.
     fn ends_with_a_header(&self, frame: &Downlink, at: usize) -> bool {
         let end = at.saturating_add(frame.kind().len());
-        matches!(
-            self.buf.as_slice().get(end.saturating_sub(2)..end),
-            Some([a, b]) if matches!(Kind::from_header(*a, *b), Some(Kind::Telemetry(_)))
-        )
+        self.buf
+            .as_slice()
+            .get(end.saturating_sub(2)..end)
+            .and_then(telemetry_header)
+            .is_some()
     }
 
     /// Whether the telemetry candidate `frame` at the front of the window ends with a whole
@@ -628,23 +629,12 @@ impl DownlinkParser {
         let len = frame.kind().len();
         let bytes = self.buf.as_slice().get(..len).unwrap_or(&[]);
         // (A frame of the same stream has the same length: only another stream's ends there.)
-        bytes
-            .windows(2)
-            .enumerate()
-            .skip(1)
-            .any(|(off, pair)| match pair {
-                [a, b] => match Kind::from_header(*a, *b) {
-                    Some(Kind::Telemetry(inner)) => {
-                        Kind::Telemetry(inner).len() == len.saturating_sub(off)
-                            && matches!(
-                                self.counts.rel(inner, seq, off),
-                                Rel::Continues | Rel::Near
-                            )
-                    }
-                    _ => false,
-                },
-                _ => false,
+        bytes.windows(2).enumerate().skip(1).any(|(off, pair)| {
+            telemetry_header(pair).is_some_and(|inner| {
+                Kind::Telemetry(inner).len() == len.saturating_sub(off)
+                    && matches!(self.counts.rel(inner, seq, off), Rel::Continues | Rel::Near)
             })
+        })
     }
 
     /// Whether `seq` would continue (or be near) a stream other than `stream`.
@@ -886,11 +876,7 @@ impl DownlinkParser {
             }
             _ => false,
         };
-        self.buf.drop_front(len);
-        self.counts.bytes(len);
-        self.since_frame = 0;
-        self.shadow = 0;
-        self.stats.count_frame(frame.kind());
+        self.leave(frame.kind(), len);
         match (frame.kind(), frame.seq(), frame) {
             (Kind::Telemetry(stream), Some(seq), _) if !believed => self.counts.skip(stream, seq),
             (Kind::Telemetry(stream), Some(seq), _) => {
@@ -905,10 +891,6 @@ impl DownlinkParser {
             }
             _ => {}
         }
-        if self.lock == Lock::Hunting {
-            self.stats.resyncs = self.stats.resyncs.wrapping_add(1);
-        }
-        self.lock = Lock::Locked;
     }
 }
 
@@ -916,12 +898,19 @@ impl DownlinkParser {
     /// [`accept`](Self::accept) for telemetry whose count continues its stream (row 1): the
     /// frame's bytes leave the window, its count and step are taken, the parser is Locked.
     fn take_continuing(&mut self, stream: Stream, seq: u8, len: usize) {
+        self.leave(Kind::Telemetry(stream), len);
+        self.counts.take(stream, seq, true);
+    }
+
+    /// A frame of `kind`, `len` bytes, was taken: its bytes leave the window, it is counted, and
+    /// the parser is Locked right after it (the counts are the caller's).
+    #[inline]
+    fn leave(&mut self, kind: Kind, len: usize) {
         self.buf.drop_front(len);
         self.counts.bytes(len);
         self.since_frame = 0;
         self.shadow = 0;
-        self.stats.count_frame(Kind::Telemetry(stream));
-        self.counts.take(stream, seq, true);
+        self.stats.count_frame(kind);
         if self.lock == Lock::Hunting {
             self.stats.resyncs = self.stats.resyncs.wrapping_add(1);
         }
@@ -952,9 +941,20 @@ fn followed(buf: &[u8], len: usize, quiet: bool) -> Option<bool> {
 /// Whether `bytes` hold a telemetry header (a reply's value that might be a cut reply with the
 /// next frame's start in it).
 fn holds_a_frame_start(bytes: &[u8]) -> bool {
-    bytes.windows(2).any(
-        |w| matches!(w, [a, b] if matches!(Kind::from_header(*a, *b), Some(Kind::Telemetry(_)))),
-    )
+    bytes
+        .windows(2)
+        .any(|pair| telemetry_header(pair).is_some())
+}
+
+/// The stream whose telemetry header `pair` is, if it is one.
+fn telemetry_header(pair: &[u8]) -> Option<Stream> {
+    match pair {
+        [a, b] => match Kind::from_header(*a, *b) {
+            Some(Kind::Telemetry(stream)) => Some(stream),
+            _ => None,
+        },
+        _ => None,
+    }
 }
 
 /// The frames in a slice, from [`DownlinkParser::frames`].
