@@ -211,6 +211,50 @@ impl Counts {
         steps.iter().any(|s| s.hits > 0 && s.delta == delta)
     }
 
+    /// The learnt step `count` takes `stream` on by, when nothing else has to be weighed: the
+    /// stream has a count, no far count is pending, and `count` is one learnt step on. Then
+    /// [`rel`](Self::rel) says [`Rel::Continues`], and [`take_step`](Self::take_step) does what
+    /// [`take`](Self::take) would. `None`: ask `rel`.
+    #[inline]
+    pub fn learnt_step(&self, stream: Stream, count: u8) -> Option<usize> {
+        let i = stream.index();
+        if self.known & (1 << i) == 0 || !matches!(self.alt.get(i), Some(None)) {
+            return None;
+        }
+        let delta = count.wrapping_sub(*self.last.get(i)?);
+        self.steps
+            .get(i)?
+            .iter()
+            .position(|s| s.hits > 0 && s.delta == delta)
+    }
+
+    /// [`take`](Self::take) for a count one learnt step on (`step`, from
+    /// [`learnt_step`](Self::learnt_step)): the step is seen once more, the count confirmed.
+    #[inline]
+    pub fn take_step(&mut self, stream: Stream, step: usize, count: u8) {
+        let i = stream.index();
+        if let Some(s) = self.steps.get_mut(i).and_then(|steps| steps.get_mut(step)) {
+            s.hits = s.hits.saturating_add(1);
+        }
+        self.confirmed |= 1 << i;
+        self.set_last(i, count);
+    }
+
+    /// Stream `i`'s count is now `count`, seen just now.
+    #[inline]
+    fn set_last(&mut self, i: usize, count: u8) {
+        self.known |= 1 << i;
+        if let Some(l) = self.last.get_mut(i) {
+            *l = count;
+        }
+        if let Some(s) = self.since.get_mut(i) {
+            *s = 0;
+        }
+        if let Some(q) = self.quiet_ms.get_mut(i) {
+            *q = 0;
+        }
+    }
+
     /// A frame of `stream` with `count` was taken. `learn`: its step, if new, is one the line
     /// really takes (the frame was taken on evidence that does not rest on its count).
     pub fn take(&mut self, stream: Stream, count: u8, learn: bool) {
@@ -251,16 +295,7 @@ impl Counts {
                 }
             }
         }
-        self.known |= bit;
-        if let Some(l) = self.last.get_mut(i) {
-            *l = count;
-        }
-        if let Some(s) = self.since.get_mut(i) {
-            *s = 0;
-        }
-        if let Some(q) = self.quiet_ms.get_mut(i) {
-            *q = 0;
-        }
+        self.set_last(i, count);
     }
 
     /// A frame of `stream` came whose count byte is not to be believed (a far count taken on a

@@ -164,7 +164,8 @@ impl Buf {
         match self.bytes.get_mut(usize::from(self.end)) {
             Some(slot) => {
                 *slot = byte;
-                self.end = self.end.saturating_add(1);
+                // (`end` indexes the window: no wrap.)
+                self.end = self.end.wrapping_add(1);
                 true
             }
             None => false,
@@ -309,13 +310,15 @@ impl DownlinkParser {
         // needs more bytes than this one (a frame, or a frame of the chain after it, is still
         // incomplete); nothing can be decided, so the byte is only stored.
         if self.missing > 1 && self.buf.push(byte) {
-            self.missing = self.missing.saturating_sub(1);
+            // (`missing` > 1: no wrap.)
+            self.missing = self.missing.wrapping_sub(1);
             return None;
         }
         self.push_slow(byte)
     }
 
-    /// [`push`](Self::push) when a decision may fall.
+    /// [`push`](Self::push) when a decision may fall: the frame's first bytes and its last take
+    /// short ways; anything else goes through [`push_general`](Self::push_general).
     #[inline(never)]
     fn push_slow(&mut self, byte: u8) -> Option<Downlink> {
         if self.missing > 1 {
@@ -350,6 +353,12 @@ impl DownlinkParser {
                 _ => {}
             }
         }
+        self.push_general(byte)
+    }
+
+    /// [`push`](Self::push) through the general judgement.
+    #[inline(never)]
+    fn push_general(&mut self, byte: u8) -> Option<Downlink> {
         let ready = if self.drain { self.poll() } else { None };
         self.append(&[byte]);
         match ready {
@@ -378,6 +387,15 @@ impl DownlinkParser {
                     }
                     bytes = bytes.get(junk..).unwrap_or(&[]);
                     continue;
+                }
+            }
+            // The window empty on a boundary, a whole frame at the front of `bytes` that row 1
+            // takes: taken straight from the slice, never copied.
+            if self.buf.len() == 0 {
+                if let Some(frame) = aligned_frame(bytes) {
+                    if self.take_aligned(&frame) {
+                        return (Some(frame), bytes.get(frame.kind().len()..).unwrap_or(&[]));
+                    }
                 }
             }
             // A frame whose header is (or starts) at the front is taken whole: nothing can be
@@ -415,23 +433,27 @@ impl DownlinkParser {
     /// alone there and the rules take it at once (rows 1 and 2: its count continues, or it is
     /// the awaited reply), it is taken without going through the general judgement; otherwise
     /// the general judgement runs. The same decision either way: a shortcut, not a rule.
+    #[inline(never)]
     fn complete(&mut self) -> Option<Downlink> {
         let bytes = self.buf.as_slice();
         if let [first, second, ..] = *bytes {
             if let Some(kind) = Kind::from_header(first, second) {
+                // Incomplete (a read that ended inside it): the judgement would wait for the
+                // rest, so wait for it without judging.
+                if let Some(more) = kind.len().checked_sub(bytes.len()).filter(|n| *n > 0) {
+                    self.drain = false;
+                    self.missing = if more > 1 {
+                        u8::try_from(more).unwrap_or(u8::MAX)
+                    } else {
+                        0
+                    };
+                    return None;
+                }
                 if kind.len() == bytes.len() {
                     if let Ok(frame) = Downlink::decode(bytes) {
                         // Row 1, the common case, without the general bookkeeping.
-                        if let (Kind::Telemetry(stream), Some(seq)) = (kind, frame.seq()) {
-                            if self.lock != Lock::Hunting
-                                && rules::need(self.lock, Class::Continues) == Need::Now
-                                && self.counts.rel(stream, seq, 0) == Rel::Continues
-                            {
-                                self.missing = 0;
-                                self.take_continuing(stream, seq, kind.len());
-                                self.drain = false;
-                                return Some(frame);
-                            }
+                        if self.take_aligned(&frame) {
+                            return Some(frame);
                         }
                         let class = self.class(&frame, 0);
                         if rules::need(self.lock, class) == Need::Now {
@@ -445,6 +467,36 @@ impl DownlinkParser {
             }
         }
         self.poll()
+    }
+
+    /// Row 1 for `frame`, whose bytes are alone in the window or, the window empty, about to be
+    /// consumed straight from the caller's slice: on a boundary, telemetry whose count is one
+    /// learnt step on is taken at once (`true`), with no judgement and no copy. Anything else
+    /// (`false`, nothing done) goes through the rules: this is a shortcut, not a rule.
+    #[inline]
+    fn take_aligned(&mut self, frame: &Downlink) -> bool {
+        // (Row 1 holds on a boundary whatever kind of boundary it is.)
+        const _: () = assert!(matches!(
+            (
+                rules::need(Lock::Locked, Class::Continues),
+                rules::need(Lock::Tentative, Class::Continues),
+            ),
+            (Need::Now, Need::Now)
+        ));
+        if self.lock == Lock::Hunting {
+            return false;
+        }
+        let (Kind::Telemetry(stream), Some(seq)) = (frame.kind(), frame.seq()) else {
+            return false;
+        };
+        let Some(step) = self.counts.learnt_step(stream, seq) else {
+            return false;
+        };
+        self.leave(frame.kind(), frame.kind().len());
+        self.counts.take_step(stream, step, seq);
+        self.missing = 0;
+        self.drain = false;
+        true
     }
 
     /// Emits a frame that is already decided in the window, if any, without a new byte.
@@ -915,6 +967,19 @@ impl DownlinkParser {
             self.stats.resyncs = self.stats.resyncs.wrapping_add(1);
         }
         self.lock = Lock::Locked;
+    }
+}
+
+/// The telemetry frame whose header starts `bytes`, if all of it is there.
+#[inline]
+fn aligned_frame(bytes: &[u8]) -> Option<Downlink> {
+    let kind = match bytes {
+        [first, second, ..] => Kind::from_header(*first, *second)?,
+        _ => return None,
+    };
+    match kind {
+        Kind::Telemetry(_) => Downlink::decode(bytes.get(..kind.len())?).ok(),
+        Kind::Reply => None,
     }
 }
 
