@@ -430,9 +430,9 @@ impl DownlinkParser {
     }
 
     /// The bytes just stored may have completed the frame at the front of the window: if it is
-    /// alone there and the rules take it at once (rows 1 and 2: its count continues, or it is
-    /// the awaited reply), it is taken without going through the general judgement; otherwise
-    /// the general judgement runs. The same decision either way: a shortcut, not a rule.
+    /// alone there and row 1 takes it ([`take_aligned`](Self::take_aligned)), it is taken
+    /// without the general judgement; a frame still incomplete waits without it; anything else
+    /// is judged. The same decision either way: a shortcut, not a rule.
     #[inline(never)]
     fn complete(&mut self) -> Option<Downlink> {
         let bytes = self.buf.as_slice();
@@ -453,13 +453,6 @@ impl DownlinkParser {
                     if let Ok(frame) = Downlink::decode(bytes) {
                         // Row 1, the common case, without the general bookkeeping.
                         if self.take_aligned(&frame) {
-                            return Some(frame);
-                        }
-                        let class = self.class(&frame, 0);
-                        if rules::need(self.lock, class) == Need::Now {
-                            self.missing = 0;
-                            self.accept(&frame, kind.len(), class);
-                            self.drain = false;
                             return Some(frame);
                         }
                     }
