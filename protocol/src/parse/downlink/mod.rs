@@ -261,8 +261,10 @@ pub struct DownlinkParser {
     drain: bool,
     /// Bytes consumed since the last frame taken (saturating).
     since_frame: u16,
-    /// Bytes still missing from the frame whose header is at the front of the window, once
-    /// judging it has needed more (0: none known; always 0 while `drain`): until the last one, a
+    /// Bytes to store before anything can be decided (0 or 1: none; always 0 while `drain`):
+    /// the rest of the frame whose header is at the front of the window, once judging it has
+    /// needed more; or, right after a frame taken by row 1 with the window empty, the next
+    /// frame's two header bytes (the first is judged with the second). Until the last one, a
     /// byte is only stored.
     missing: u8,
     /// Start positions still inside the frame last rejected on a boundary (row 14).
@@ -487,7 +489,9 @@ impl DownlinkParser {
         };
         self.leave(frame.kind(), frame.kind().len());
         self.counts.take_step(stream, step, seq);
-        self.missing = 0;
+        // The window is empty: the next frame's header is stored, then judged (a junk first
+        // byte is rejected with the second as it would have been on its own).
+        self.missing = if self.buf.len() == 0 { 2 } else { 0 };
         self.drain = false;
         true
     }
