@@ -364,7 +364,11 @@ impl DownlinkParser {
         let ready = if self.drain { self.poll() } else { None };
         self.append(&[byte]);
         match ready {
-            Some(frame) => Some(frame),
+            Some(frame) => {
+                // (The window is not empty now: `missing` of 2 is for an empty one.)
+                self.missing = 0;
+                Some(frame)
+            }
             None => self.poll(),
         }
     }
@@ -461,7 +465,7 @@ impl DownlinkParser {
                 }
             }
         }
-        self.poll()
+        self.run(false)
     }
 
     /// Row 1 for `frame`, whose bytes are alone in the window or, the window empty, about to be
@@ -498,7 +502,8 @@ impl DownlinkParser {
 
     /// Emits a frame that is already decided in the window, if any, without a new byte.
     pub fn poll(&mut self) -> Option<Downlink> {
-        self.run(false)
+        // (After a chain proved a frame, the next is often alone in the window: row 1.)
+        self.complete()
     }
 
     /// Tells the parser the line has been quiet for `ms` more milliseconds (any gap of two or
