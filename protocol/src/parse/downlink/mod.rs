@@ -77,8 +77,10 @@
 //! # Memory and time
 //!
 //! Parsing state and counters are one [`DownlinkParser`] (size asserted at compile time). While
-//! Locked, a frame's bytes are only stored; the judgement runs on its last byte (row 1).
-//! [`DownlinkParser::push_slice`] copies a frame's body in one step. Nothing allocates.
+//! Locked, a frame's bytes are only stored; on its last byte a count one learnt step on takes
+//! it (row 1) without the general judgement. [`DownlinkParser::push_slice`] takes such a frame
+//! straight from the caller's slice when the window is empty, and otherwise copies a frame's
+//! body in one step. Nothing allocates.
 //!
 //! # Panics
 //!
