@@ -7,8 +7,14 @@
 //! (up to [`STEPS`] of them: a shared counter gives the IMU steps of 1, 2 and 3, a time tick
 //! the encoders a step of 4). A count **continues** its stream when it is one learnt step on;
 //! it is **near** when it is a few steps on (frames lost: as many as the bytes and the quiet
-//! time since the stream's last frame can hold); otherwise it is **far**. A stream with no
-//! step learnt yet takes any step from 1 to [`FIRST_STEP_MAX`] as continuing.
+//! time since the stream's last frame can hold, [`LOST_UNSEEN`] more if bytes were thrown away
+//! since); otherwise it is **far**. A stream with no step learnt yet takes any step from 1 to
+//! [`FIRST_STEP_MAX`] as continuing.
+//!
+//! **Steps are learnt only from a line that lost nothing** since the stream's last frame (no
+//! byte thrown away): after a loss, a count may have moved on by frames lost, and a step learnt
+//! from that would let false frames' counts through for good. On such a line a near count
+//! cannot be frames lost: seen twice, its distance is a step ([`Counts::take_near`]).
 
 use crate::telemetry::Stream;
 
@@ -29,6 +35,9 @@ pub const PERIOD_MS: [u16; 3] = [10, 40, 1_000];
 /// Lost frames allowed at most, however long the silence: a count this many steps on is still
 /// near, never more (so the count check never vanishes).
 pub const MAX_LOST: u16 = 64;
+
+/// Frames a stream may have lost unseen when bytes were thrown away since its last frame.
+pub const LOST_UNSEEN: u16 = 2;
 
 /// How a count relates to its stream's last one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -72,6 +81,12 @@ pub struct Counts {
     /// Per stream, how far the far count in `alt` was from the count before it: a step the
     /// board really takes once the stream's next frame continues `alt`.
     alt_step: [u8; 3],
+    /// Bit `i`: no byte was thrown away since stream `i`'s last frame (see
+    /// [`Counts::take_near`]).
+    lossless: u8,
+    /// Per stream, the last near count's distance from the count before it, when nothing was
+    /// lost in between (0: none).
+    near_delta: [u8; 3],
 }
 
 impl Default for Counts {
@@ -92,6 +107,8 @@ impl Counts {
             quiet_ms: [0; 3],
             alt: [None; 3],
             alt_step: [0; 3],
+            lossless: 0,
+            near_delta: [0; 3],
         }
     }
 
@@ -131,9 +148,13 @@ impl Counts {
             .checked_div(per)
             .unwrap_or(0);
         let by_time = quiet.checked_div(period).unwrap_or(0);
+        // Bytes thrown away since: the line may have lost more than it shows (an overrun
+        // drops whole stretches, which no byte count sees).
+        let by_loss = if self.clean(i) { 0 } else { LOST_UNSEEN };
         by_bytes
             .saturating_add(by_time)
             .saturating_add(u16::from(quiet > 0))
+            .saturating_add(by_loss)
             .min(MAX_LOST)
     }
 
@@ -240,9 +261,42 @@ impl Counts {
         self.set_last(i, count);
     }
 
+    /// A frame of `stream` whose count is near (frames lost, see [`Rel::Near`]) was taken; `true`
+    /// if its distance is learnt as a step instead.
+    ///
+    /// Frames lost explain a near count only if the line lost something. When no byte was
+    /// thrown away and the line was never quiet since the stream's last frame, every byte in
+    /// between was a frame taken: none of this stream's can be missing, and the board stepped
+    /// its count by that much (one counter shared by all streams steps the IMU by 2 when an
+    /// encoder frame came between, a multiple of its usual 1). The same distance seen twice
+    /// that way is learnt; once may still be a frame lost whole with nothing else damaged.
+    pub fn take_near(&mut self, stream: Stream, count: u8) -> bool {
+        let i = stream.index();
+        let delta = count.wrapping_sub(self.last(stream));
+        let clean = self.clean(i) && self.quiet_ms.get(i).is_some_and(|q| *q == 0);
+        let Some(seen) = self.near_delta.get_mut(i) else {
+            return false;
+        };
+        let again = clean && *seen == delta;
+        *seen = if clean && !again { delta } else { 0 };
+        self.take(stream, count, again);
+        again
+    }
+
+    /// Whether no byte was thrown away since stream `i`'s last frame.
+    fn clean(&self, i: usize) -> bool {
+        self.lossless & (1 << i) != 0
+    }
+
+    /// A byte was thrown away: a near count after it may be frames lost.
+    pub fn discarded(&mut self) {
+        self.lossless = 0;
+    }
+
     /// Stream `i`'s count is now `count`, seen just now.
     #[inline]
     fn set_last(&mut self, i: usize, count: u8) {
+        self.lossless |= 1 << i;
         self.known |= 1 << i;
         if let Some(l) = self.last.get_mut(i) {
             *l = count;
@@ -257,9 +311,15 @@ impl Counts {
 
     /// A frame of `stream` with `count` was taken. `learn`: its step, if new, is one the line
     /// really takes (the frame was taken on evidence that does not rest on its count).
+    ///
+    /// A new step is learnt only if the line lost nothing since the stream's last frame (see
+    /// [`take_near`](Self::take_near)): after a loss, a count that moved on by an unknown amount
+    /// may be frames lost (under a shared counter, the encoders' 5 + 6 = 11 when one of them was
+    /// lost), and a step learnt from that lets false frames' counts through for good.
     pub fn take(&mut self, stream: Stream, count: u8, learn: bool) {
         let i = stream.index();
         let bit = 1u8 << i;
+        let clean = self.clean(i);
         // (Most frames have no far count pending: skip the check then.)
         let rebased = matches!(self.alt.get(i), Some(Some(_))) && self.continues_alt(stream, count);
         if let Some(alt) = self.alt.get_mut(i) {
@@ -286,7 +346,8 @@ impl Counts {
                     if rebased || (none_learnt && (1..=FIRST_STEP_MAX).contains(&delta)) {
                         self.confirmed |= bit;
                     }
-                    if learn && (1..=127).contains(&delta) {
+                    // (A re-based step was checked when its far count came: see `skip`.)
+                    if learn && (clean || rebased) && (1..=127).contains(&delta) {
                         // Replace the least seen step.
                         if let Some(slot) = steps.iter_mut().min_by_key(|s| s.hits) {
                             *slot = Step { delta, hits: 1 };
@@ -322,23 +383,22 @@ impl Counts {
         if let Some(alt) = self.alt.get_mut(i) {
             *alt = Some(count);
         }
-        if let Some(alt_step) = self.alt_step.get_mut(i) {
-            *alt_step = count.wrapping_sub(self.last.get(i).copied().unwrap_or(count));
+        // (A step only from a line that lost nothing; 0 is no step.)
+        let alt_step = if self.clean(i) {
+            count.wrapping_sub(self.last.get(i).copied().unwrap_or(count))
+        } else {
+            0
+        };
+        if let Some(slot) = self.alt_step.get_mut(i) {
+            *slot = alt_step;
         }
         let step = self
             .steps
             .get(i)
             .and_then(|steps| steps.iter().filter(|s| s.hits > 0).map(|s| s.delta).min())
             .unwrap_or(1);
-        if let Some(l) = self.last.get_mut(i) {
-            *l = l.wrapping_add(step);
-        }
-        if let Some(s) = self.since.get_mut(i) {
-            *s = 0;
-        }
-        if let Some(q) = self.quiet_ms.get_mut(i) {
-            *q = 0;
-        }
+        let last = self.last(stream).wrapping_add(step);
+        self.set_last(i, last);
     }
 
     /// `n` more bytes received.
@@ -462,5 +522,58 @@ mod tests {
         assert_eq!(c.rel(Stream::Imu, 8, 0), Rel::Continues);
         assert_eq!(c.rel(Stream::Imu, 9, 0), Rel::Continues);
         assert_eq!(c.rel(Stream::Imu, 7u8.wrapping_add(100), 0), Rel::Far);
+    }
+
+    #[test]
+    fn a_near_count_on_a_line_that_lost_nothing_is_a_step_once_seen_twice() {
+        let mut c = Counts::new();
+        for count in [10u8, 11, 12] {
+            c.take(Stream::Imu, count, true);
+        }
+        // +2 with 26 bytes between (an encoder frame): one frame lost, or a step.
+        assert_eq!(c.rel(Stream::Imu, 14, 26), Rel::Near);
+        assert!(!c.take_near(Stream::Imu, 14));
+        c.take(Stream::Imu, 15, true);
+        assert_eq!(c.rel(Stream::Imu, 17, 26), Rel::Near);
+        assert!(c.take_near(Stream::Imu, 17));
+        assert_eq!(c.rel(Stream::Imu, 19, 0), Rel::Continues);
+        // After bytes thrown away, a near count is frames lost: nothing learnt.
+        let mut c = Counts::new();
+        for count in [10u8, 11, 12] {
+            c.take(Stream::Imu, count, true);
+        }
+        assert!(!c.take_near(Stream::Imu, 14));
+        c.take(Stream::Imu, 15, true);
+        c.discarded();
+        assert!(!c.take_near(Stream::Imu, 17));
+        assert_ne!(c.rel(Stream::Imu, 19, 0), Rel::Continues);
+    }
+
+    #[test]
+    fn no_step_is_learnt_across_bytes_thrown_away() {
+        // Encoders under a shared counter step by 5; one lost gives 5 + 6 = 11.
+        let mut c = Counts::new();
+        for count in [0u8, 5, 10] {
+            c.take(Stream::Encoders, count, true);
+        }
+        c.discarded();
+        c.take(Stream::Encoders, 21, true);
+        assert_eq!(c.rel(Stream::Encoders, 32, 0), Rel::Far);
+        // The same distance on a line that lost nothing is a step.
+        c.take(Stream::Encoders, 32, true);
+        assert_eq!(c.rel(Stream::Encoders, 43, 0), Rel::Continues);
+    }
+
+    #[test]
+    fn bytes_thrown_away_allow_frames_lost_unseen() {
+        let mut c = Counts::new();
+        for count in [10u8, 11, 12] {
+            c.take(Stream::Imu, count, true);
+        }
+        // 30 bytes since: 2 IMU frames' worth, so up to 2 lost (+3 at most).
+        assert_eq!(c.rel(Stream::Imu, 16, 30), Rel::Far);
+        // Bytes were thrown away: an overrun may have taken more than the bytes show.
+        c.discarded();
+        assert_eq!(c.rel(Stream::Imu, 16, 30), Rel::Near);
     }
 }

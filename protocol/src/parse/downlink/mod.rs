@@ -71,6 +71,10 @@
 //! * **A count is a guess until its stream continues it**: a count far from one that no frame
 //!   of its own stream has continued yet (a false frame passed over in a chain while the line
 //!   was damaged, then a second with no battery frame to correct it) counts as unknown, not far.
+//! * **Steps are learnt only from a line that lost nothing** ([`counts`]): a near count with
+//!   no byte thrown away since its stream's last frame is a step, not frames lost (seen twice:
+//!   a shared counter steps the IMU by 2 after an encoder frame); a count that moved on across
+//!   a loss teaches nothing (it may be frames lost), and a loss allows frames lost unseen.
 //! * After [`FORGET_AFTER`] bytes without a frame taken, every count is forgotten (the board
 //!   may have restarted): nothing can hold the parser off for ever.
 //!
@@ -889,6 +893,7 @@ impl DownlinkParser {
     /// Counts one byte thrown away (already out of the window, or never in it).
     fn discard(&mut self) {
         self.consumed(1);
+        self.counts.discarded();
         self.stats.discarded = self.stats.discarded.wrapping_add(1);
         if self.lock != Lock::Hunting {
             self.stats.lock_losses = self.stats.lock_losses.wrapping_add(1);
@@ -924,7 +929,7 @@ impl DownlinkParser {
         // byte, and the stream moves on by a step.
         let believed = class != Class::Far
             || self.chain(self.buf.as_slice(), frame, len, class, Chain::Own, false) == Ok(true);
-        // Frames lost (a near count) teach no step.
+        // Frames lost (a near count) teach no step, unless nothing was lost.
         let near = match (class, frame.kind(), frame.seq()) {
             (Class::Near, ..) => true,
             (Class::Ambiguous, Kind::Telemetry(stream), Some(seq)) => {
@@ -935,13 +940,13 @@ impl DownlinkParser {
         self.leave(frame.kind(), len);
         match (frame.kind(), frame.seq(), frame) {
             (Kind::Telemetry(stream), Some(seq), _) if !believed => self.counts.skip(stream, seq),
-            (Kind::Telemetry(stream), Some(seq), _) => {
-                if near {
-                    self.stats
-                        .count_gap(stream, self.counts.missed(stream, seq));
+            (Kind::Telemetry(stream), Some(seq), _) if near => {
+                let missed = self.counts.missed(stream, seq);
+                if !self.counts.take_near(stream, seq) {
+                    self.stats.count_gap(stream, missed);
                 }
-                self.counts.take(stream, seq, !near);
             }
+            (Kind::Telemetry(stream), Some(seq), _) => self.counts.take(stream, seq, true),
             (_, _, Downlink::Reply(reply)) if self.expect == Some(reply.code) => {
                 self.expect = None;
             }

@@ -362,3 +362,37 @@ fn a_dropout_across_a_quiet_line_leaves_the_parser_hunting() {
     out.extend(drain_quiet(&mut p, 8));
     assert_eq!(out, vec![imu(8), imu(9)]);
 }
+
+#[test]
+fn under_a_shared_counter_the_imus_step_after_an_encoder_frame_is_learnt() {
+    // One counter for all streams: IMU 1, 2, 3, encoders 4, IMU 5 (+2: a multiple of its
+    // usual 1, so "one frame lost" until the line shows nothing was lost), ...
+    let encoders = |seq| Encoders {
+        ticks: [10, -10, 20, -20],
+        seq,
+    };
+    let mut p = locked();
+    let mut late = Vec::new();
+    let mut count = 3u8;
+    for round in 0..4 {
+        count += 1;
+        // (The encoders' first frame waits for a header: row 4.)
+        let mut out = feed(&mut p, &encoders(count).encode());
+        for _ in 0..3 {
+            count += 1;
+            let frame = imu(count, 7).encode();
+            let (head, last) = frame.split_at(frame.len() - 1);
+            out.extend(feed(&mut p, head));
+            let now = feed(&mut p, last);
+            if now.last().and_then(Downlink::seq) != Some(count) {
+                late.push(count);
+            }
+            out.extend(now);
+        }
+        out.extend(core::iter::from_fn(|| p.poll()));
+        assert_eq!(out.len(), 4, "round {round}: every frame");
+    }
+    // The first two IMU frames after an encoder frame wait for a header (frames may have been
+    // lost); from the second on, +2 is a step: on their last byte.
+    assert_eq!(late, vec![5, 9]);
+}
