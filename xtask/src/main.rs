@@ -7,7 +7,7 @@
 //! | `size` | flash and RAM of every board's firmware, and the protocol crate's share (size probes) |
 //! | `icount` | the downlink parser's instructions per byte on the emulated Cortex-M4 and Cortex-M0 |
 //! | `fuzz [SECONDS]` | only the fuzz targets, each for SECONDS (default 30), exploring: random seed, corpora kept |
-//! | `sweep` | the full noise sweep of the downlink parser over every stream model (a few minutes; not part of `test`) |
+//! | `sweep [--seed N]` | the full noise sweep of the downlink parser over every stream model (a few minutes; not part of `test`) |
 //! | `bench` | the parser beside its peers (sbus-rs, uf-crsf, crsf) in one run: a table with the ratios (not part of `test`, which only builds it) |
 //! | `host-demo` | frames built and a noisy board stream parsed, on the host |
 //! | `qemu ELF [--scenario NAME]` | boots a firmware in QEMU against the simulated chassis (the QEMU board's cargo runner) |
@@ -32,7 +32,7 @@ fn main() -> ExitCode {
         "icount" => firmware::icount(),
         "qemu" => firmware::qemu(&std::env::args().skip(2).collect::<Vec<_>>()),
         "test" => test(),
-        "sweep" => sweep(),
+        "sweep" => sweep(&std::env::args().skip(2).collect::<Vec<_>>()),
         "bench" => bench(),
         "fuzz" => {
             let seconds = std::env::args().nth(2).unwrap_or_else(|| "30".to_string());
@@ -45,7 +45,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask <demo | test | size | icount | sweep | bench | fuzz [SECONDS] | \
+                "usage: cargo xtask <demo | test | size | icount | sweep [--seed N] | bench | fuzz [SECONDS] | \
                  host-demo | qemu FIRMWARE.elf>"
             );
             return ExitCode::from(2);
@@ -232,8 +232,10 @@ fn bench() -> Result<(), String> {
     Ok(())
 }
 
-fn sweep() -> Result<(), String> {
-    host_tests("--bin", "noise-sweep", &[])
+/// The noise sweep; `--seed N` for a seed other than the one the figures quote.
+fn sweep(args: &[String]) -> Result<(), String> {
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    host_tests("--bin", "noise-sweep", &args)
 }
 
 fn test() -> Result<(), String> {
