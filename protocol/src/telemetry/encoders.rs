@@ -59,8 +59,11 @@ impl Encoders {
     /// Decodes exactly one encoder frame.
     pub fn decode(bytes: &[u8]) -> Result<Self, Error> {
         check_frame(bytes, &Self::HEADER, Self::LEN)?;
+        // (Each field by name, not `array::map`: see `Imu::decode`.)
+        let [t0, t1, t2, t3] = field::TICKS;
+        let at = |offset| wire::i16_at(bytes, offset);
         Ok(Encoders {
-            ticks: field::TICKS.map(|at| wire::i16_at(bytes, at)),
+            ticks: [at(t0), at(t1), at(t2), at(t3)],
             seq: wire::u8_at(bytes, field::SEQ),
         })
     }

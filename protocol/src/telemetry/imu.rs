@@ -66,9 +66,13 @@ impl Imu {
     /// Decodes exactly one IMU frame.
     pub fn decode(bytes: &[u8]) -> Result<Self, Error> {
         check_frame(bytes, &Self::HEADER, Self::LEN)?;
+        // (Each field by name, not `array::map`: that one the optimiser does not always unroll,
+        // and this is the parser's hot path.)
+        let ([ax, ay, az], [gx, gy, gz]) = (field::ACCEL, field::GYRO);
+        let at = |offset| wire::i16_at(bytes, offset);
         Ok(Imu {
-            accel: field::ACCEL.map(|at| wire::i16_at(bytes, at)),
-            gyro: field::GYRO.map(|at| wire::i16_at(bytes, at)),
+            accel: [at(ax), at(ay), at(az)],
+            gyro: [at(gx), at(gy), at(gz)],
             seq: wire::u8_at(bytes, field::SEQ),
         })
     }

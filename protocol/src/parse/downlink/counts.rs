@@ -129,6 +129,22 @@ impl Counts {
             .is_some_and(|steps| steps.iter().any(|s| s.hits > 0))
     }
 
+    /// Which of stream `i`'s learnt steps is `delta`, if one is.
+    fn step_of(&self, i: usize, delta: u8) -> Option<usize> {
+        self.steps
+            .get(i)?
+            .iter()
+            .position(|s| s.hits > 0 && s.delta == delta)
+    }
+
+    /// Stream `i`'s smallest learnt step (1 if none).
+    fn smallest_step(&self, i: usize) -> u8 {
+        self.steps
+            .get(i)
+            .and_then(|steps| steps.iter().filter(|s| s.hits > 0).map(|s| s.delta).min())
+            .unwrap_or(1)
+    }
+
     /// `stream`'s last count (0 if none).
     pub fn last(&self, stream: Stream) -> u8 {
         self.last.get(stream.index()).copied().unwrap_or(0)
@@ -225,11 +241,10 @@ impl Counts {
             return false;
         };
         let delta = count.wrapping_sub(alt);
-        let steps = self.steps.get(i).copied().unwrap_or_default();
-        if steps.iter().all(|s| s.hits == 0) {
+        if !self.has_steps(stream) {
             return (1..=FIRST_STEP_MAX).contains(&delta);
         }
-        steps.iter().any(|s| s.hits > 0 && s.delta == delta)
+        self.step_of(i, delta).is_some()
     }
 
     /// The learnt step `count` takes `stream` on by, when nothing else has to be weighed: the
@@ -242,11 +257,7 @@ impl Counts {
         if self.known & (1 << i) == 0 || !matches!(self.alt.get(i), Some(None)) {
             return None;
         }
-        let delta = count.wrapping_sub(*self.last.get(i)?);
-        self.steps
-            .get(i)?
-            .iter()
-            .position(|s| s.hits > 0 && s.delta == delta)
+        self.step_of(i, count.wrapping_sub(*self.last.get(i)?))
     }
 
     /// [`take`](Self::take) for a count one learnt step on (`step`, from
@@ -392,12 +403,7 @@ impl Counts {
         if let Some(slot) = self.alt_step.get_mut(i) {
             *slot = alt_step;
         }
-        let step = self
-            .steps
-            .get(i)
-            .and_then(|steps| steps.iter().filter(|s| s.hits > 0).map(|s| s.delta).min())
-            .unwrap_or(1);
-        let last = self.last(stream).wrapping_add(step);
+        let last = self.last(stream).wrapping_add(self.smallest_step(i));
         self.set_last(i, last);
     }
 
@@ -430,17 +436,8 @@ impl Counts {
     /// The number of frames a count `delta` on from the last one says were missed (0 when it
     /// continues; a guess from the smallest learnt step).
     pub fn missed(&self, stream: Stream, count: u8) -> u8 {
-        let i = stream.index();
-        let last = self.last.get(i).copied().unwrap_or(0);
-        let delta = count.wrapping_sub(last);
-        let steps = self.steps.get(i).copied().unwrap_or_default();
-        let step = steps
-            .iter()
-            .filter(|s| s.hits > 0)
-            .map(|s| s.delta)
-            .min()
-            .unwrap_or(1)
-            .max(1);
+        let delta = count.wrapping_sub(self.last(stream));
+        let step = self.smallest_step(stream.index()).max(1);
         delta.checked_div(step).unwrap_or(0).saturating_sub(1)
     }
 }
