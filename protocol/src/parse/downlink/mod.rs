@@ -800,7 +800,11 @@ impl DownlinkParser {
                         return Ok(quiet_vouches);
                     }
                     (Some(a), None) if Kind::may_start(*a) && !quiet => return undecided(buf, 1),
-                    (None, _) if !quiet => return undecided(buf, 1),
+                    // Nothing after the candidate yet: the next header is two bytes. Its
+                    // first alone allows one decision (not a header: reject), and taking it
+                    // a byte later, with the second, decides the same (a reply nobody awaits
+                    // is judged once less).
+                    (None, _) if !quiet => return undecided(buf, if at == pos { 2 } else { 1 }),
                     _ => {}
                 }
             }
