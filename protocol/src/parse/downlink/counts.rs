@@ -446,6 +446,15 @@ impl Counts {
 mod tests {
     use super::*;
 
+    /// Counts that have taken `counts` of `stream`, in order, each teaching its step.
+    fn seen(stream: Stream, counts: &[u8]) -> Counts {
+        let mut c = Counts::new();
+        for count in counts {
+            c.take(stream, *count, true);
+        }
+        c
+    }
+
     #[test]
     fn steps_are_learnt_from_the_line() {
         let mut c = Counts::new();
@@ -485,10 +494,7 @@ mod tests {
     fn a_far_count_the_stream_then_continues_teaches_its_step() {
         // One counter shared by all streams: the encoders usually step by 5, by 6 when a
         // battery frame came between.
-        let mut c = Counts::new();
-        for count in [0u8, 5, 10] {
-            c.take(Stream::Encoders, count, true);
-        }
+        let mut c = seen(Stream::Encoders, &[0, 5, 10]);
         assert_eq!(c.rel(Stream::Encoders, 16, 0), Rel::Far);
         // Taken on a certain boundary but not believed; the next frame continues it.
         c.skip(Stream::Encoders, 16);
@@ -523,10 +529,7 @@ mod tests {
 
     #[test]
     fn a_near_count_on_a_line_that_lost_nothing_is_a_step_once_seen_twice() {
-        let mut c = Counts::new();
-        for count in [10u8, 11, 12] {
-            c.take(Stream::Imu, count, true);
-        }
+        let mut c = seen(Stream::Imu, &[10, 11, 12]);
         // +2 with 26 bytes between (an encoder frame): one frame lost, or a step.
         assert_eq!(c.rel(Stream::Imu, 14, 26), Rel::Near);
         assert!(!c.take_near(Stream::Imu, 14));
@@ -535,10 +538,7 @@ mod tests {
         assert!(c.take_near(Stream::Imu, 17));
         assert_eq!(c.rel(Stream::Imu, 19, 0), Rel::Continues);
         // After bytes thrown away, a near count is frames lost: nothing learnt.
-        let mut c = Counts::new();
-        for count in [10u8, 11, 12] {
-            c.take(Stream::Imu, count, true);
-        }
+        let mut c = seen(Stream::Imu, &[10, 11, 12]);
         assert!(!c.take_near(Stream::Imu, 14));
         c.take(Stream::Imu, 15, true);
         c.discarded();
@@ -549,10 +549,7 @@ mod tests {
     #[test]
     fn no_step_is_learnt_across_bytes_thrown_away() {
         // Encoders under a shared counter step by 5; one lost gives 5 + 6 = 11.
-        let mut c = Counts::new();
-        for count in [0u8, 5, 10] {
-            c.take(Stream::Encoders, count, true);
-        }
+        let mut c = seen(Stream::Encoders, &[0, 5, 10]);
         c.discarded();
         c.take(Stream::Encoders, 21, true);
         assert_eq!(c.rel(Stream::Encoders, 32, 0), Rel::Far);
@@ -563,10 +560,7 @@ mod tests {
 
     #[test]
     fn bytes_thrown_away_allow_frames_lost_unseen() {
-        let mut c = Counts::new();
-        for count in [10u8, 11, 12] {
-            c.take(Stream::Imu, count, true);
-        }
+        let mut c = seen(Stream::Imu, &[10, 11, 12]);
         // 30 bytes since: 2 IMU frames' worth, so up to 2 lost (+3 at most).
         assert_eq!(c.rel(Stream::Imu, 16, 30), Rel::Far);
         // Bytes were thrown away: an overrun may have taken more than the bytes show.
