@@ -20,7 +20,9 @@
 //! the board (telemetry or reply) for [`Config::failsafe_ms`] (100 ms), except that after a
 //! settings frame the board may stay silent for [`Config::settings_pause_ms`] (600 ms), since it
 //! pauses telemetry while settings are made (A13: up to at least 500 ms), until its telemetry
-//! comes back (the pause is then over: from there on, 100 ms of silence is a dead link).
+//! comes back (the pause is then over: from there on, 100 ms of silence is a dead link). For a
+//! read, "comes back" counts only telemetry after the reply: the board answers when it takes the
+//! read, so frames heard before the reply were on their way before the pause began.
 //!
 //! It is judged on the input already read: a shell calls [`DriverCore::tick`] only after taking
 //! in every byte the UART holds, so a slow loop never mistakes its own slowness for a dead link.
@@ -925,7 +927,12 @@ impl DriverCore {
                 });
                 Stream::Battery
             }
-            Downlink::Reply(reply) => return self.reply(reply),
+            Downlink::Reply(reply) => {
+                // Telemetry heard before the reply was sent before the board took the read
+                // (and paused): it says nothing about the pause being over.
+                self.telemetry_after_settings = 0;
+                return self.reply(reply);
+            }
         };
         self.last_telemetry_ms = Some(now_ms);
         if self.settings_sent_ms.is_some_and(|sent| now_ms > sent) {
@@ -1111,6 +1118,42 @@ mod tests {
         let _ = core.velocity(Velocity::STOP, 2_000);
         let _ = core.tick(10_000);
         assert_eq!(core.transmit(10_000), None);
+    }
+
+    #[test]
+    fn telemetry_on_its_way_before_a_reply_does_not_end_the_settings_pause() {
+        // Found by the emulator's noisy bring-up (one run in a few): a register read while
+        // moving, two IMU frames the board had sent before taking the read parsed right after
+        // it, then the reply, then the board's pause: the failsafe stopped the chassis.
+        let mut core = DriverCore::new(Config::DEFAULT);
+        let imu = |core: &mut DriverCore, seq: u8, at: u64| {
+            let frame = crate::Imu {
+                accel: [0; 3],
+                gyro: [0; 3],
+                seq,
+            }
+            .encode();
+            let mut rest = &frame[..];
+            while !rest.is_empty() {
+                rest = core.receive(rest, at).1;
+            }
+            let _ = core.tick(at);
+        };
+        // Telemetry streaming (the parser locked on it), then the read.
+        for seq in 1..=5 {
+            imu(&mut core, seq, 0);
+        }
+        assert!(core.last_telemetry_ms().is_some());
+        let _ = core.velocity(Velocity::new(0, 100, 0), 0);
+        core.start(Request::Read(Register::PendingAngle)).unwrap();
+        assert!(core.transmit(0).is_some());
+        imu(&mut core, 6, 1);
+        imu(&mut core, 7, 2);
+        reply(&mut core, Register::PendingAngle, 0, 3);
+        // The board pauses for 150 ms after the reply: no stop.
+        let _ = core.tick(160);
+        assert_eq!(core.transmit(160), None);
+        assert_eq!(core.failsafe_stops(), 0);
     }
 
     #[test]
