@@ -453,12 +453,7 @@ impl DownlinkParser {
                 // Incomplete (a read that ended inside it): the judgement would wait for the
                 // rest, so wait for it without judging.
                 if let Some(more) = kind.len().checked_sub(bytes.len()).filter(|n| *n > 0) {
-                    self.drain = false;
-                    self.missing = if more > 1 {
-                        u8::try_from(more).unwrap_or(u8::MAX)
-                    } else {
-                        0
-                    };
+                    self.wait_for(more);
                     return None;
                 }
                 if kind.len() == bytes.len() {
@@ -591,14 +586,7 @@ impl DownlinkParser {
         loop {
             match self.judge(quiet) {
                 Verdict::NeedMore(n) => {
-                    self.drain = false;
-                    // Only a wait of two bytes or more is worth the shortcut: with one, the
-                    // next byte is judged anyway (and a lone junk byte is dropped at once).
-                    self.missing = if n > 1 {
-                        u8::try_from(n).unwrap_or(u8::MAX)
-                    } else {
-                        0
-                    };
+                    self.wait_for(n);
                     return None;
                 }
                 Verdict::Reject => self.reject(),
@@ -610,6 +598,19 @@ impl DownlinkParser {
                 }
             }
         }
+    }
+
+    /// Nothing can be decided before `n` more bytes: until then they are only stored.
+    #[inline]
+    fn wait_for(&mut self, n: usize) {
+        self.drain = false;
+        // Only a wait of two bytes or more is worth the shortcut: with one, the next byte is
+        // judged anyway (and a lone junk byte is dropped at once).
+        self.missing = if n > 1 {
+            u8::try_from(n).unwrap_or(u8::MAX)
+        } else {
+            0
+        };
     }
 
     /// Appends bytes; if the window is ever full, its first byte is rejected rather than a new
