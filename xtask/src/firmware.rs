@@ -327,9 +327,10 @@ pub mod budget {
     pub const FIRMWARE_RAM: u64 = 8 * 1024;
     /// The goal for parsers + builders at opt-level "s" on thumbv7em: **not met** today.
     pub const PROTOCOL_GOAL: u64 = 4 * 1024;
-    /// What parsers + builders may not grow past (measured 9 348 B when it was set): a
-    /// regression guard until the goal above is met.
-    pub const PROTOCOL_CEILING: u64 = 10 * 1024;
+    /// What parsers + builders may not grow past: a regression guard until the goal above is
+    /// met. Set at 10 KiB (measured 9 348 B); raised to 11 KiB when the parser learnt to take
+    /// a reply nobody awaits past a damaged frame (10 776 B): recall was below its goal.
+    pub const PROTOCOL_CEILING: u64 = 11 * 1024;
 }
 
 /// Builds the probes and the bring-up firmware, prints the table, returns whether every

@@ -9,7 +9,7 @@ use crate::error::Error;
 use crate::wire;
 
 /// Byte offsets of the battery frame.
-mod field {
+pub(crate) mod field {
     pub const HEADER: usize = 0;
     pub const CENTIVOLTS: usize = 2;
     pub const PERCENT: usize = 4;

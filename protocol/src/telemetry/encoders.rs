@@ -13,7 +13,7 @@ use crate::error::Error;
 use crate::wire;
 
 /// Byte offsets of the encoder frame.
-mod field {
+pub(crate) mod field {
     pub const HEADER: usize = 0;
     /// Encoder 1..4.
     pub const TICKS: [usize; 4] = [2, 4, 6, 8];

@@ -11,7 +11,7 @@ use crate::error::Error;
 use crate::wire;
 
 /// Byte offsets of the IMU frame.
-mod field {
+pub(crate) mod field {
     pub const HEADER: usize = 0;
     /// Accel X, Y, Z.
     pub const ACCEL: [usize; 3] = [2, 4, 6];

@@ -67,6 +67,16 @@ impl Stream {
         }
     }
 
+    /// Where a frame of this stream holds its count byte.
+    #[must_use]
+    pub(crate) const fn seq_at(self) -> usize {
+        match self {
+            Stream::Imu => imu::field::SEQ,
+            Stream::Encoders => encoders::field::SEQ,
+            Stream::Battery => battery::field::SEQ,
+        }
+    }
+
     /// The nominal rate in hertz.
     #[must_use]
     pub const fn rate_hz(self) -> u16 {

@@ -320,6 +320,17 @@ impl Counts {
         }
     }
 
+    /// A frame of `stream` went by whose count byte cannot be read (the frame is damaged):
+    /// the stream moves on by its smallest step, as if the count had continued. For judging
+    /// what follows it, on a copy.
+    pub fn passed(&mut self, stream: Stream) {
+        let i = stream.index();
+        if self.knows(stream) {
+            let next = self.last(stream).wrapping_add(self.smallest_step(i));
+            self.set_last(i, next);
+        }
+    }
+
     /// A frame of `stream` with `count` was taken. `learn`: its step, if new, is one the line
     /// really takes (the frame was taken on evidence that does not rest on its count).
     ///

@@ -34,17 +34,26 @@
 //! | 6 | Tentative | telemetry, count near (the board paused) | with a header (or quiet line) after it |
 //! | 7 | Tentative | telemetry, the stream's first or a far count | when the chain vouches (far counts in it re-based), or it fills the burst up to the next quiet line |
 //! | 8 | Hunting | telemetry, count continues or near (and fits no other stream) | when the chain vouches |
-//! | 9 | Hunting | telemetry, the stream's first, or a count another stream's could explain | when its own stream's next frame in the chain continues it |
+//! | 9 | Hunting | telemetry, the stream's first, a count another stream's could explain, or any count inside a frame rejected on a boundary | when its own stream's next frame in the chain continues it |
 //! | 10 | Hunting | the awaited reply | when the chain (or a quiet line) vouches |
-//! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it) |
+//! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it); Locked, past a damaged next frame, when the frame after it continues |
 //! | 12 | Hunting | a reply nobody awaits | never |
 //! | 13 | Hunting | telemetry, count far | when its own stream's next three frames in the chain move on from it in step (the board restarted its counts) |
 //! | 14 | Hunting, inside a frame rejected on a boundary | telemetry whose last bytes are a whole frame of another stream, whose count fits that stream | never (the scan reaches the inner frame next) |
 //! | 15 | any | telemetry, count far, its last two bytes a telemetry header (a cut frame running into the next one) | never |
 //!
-//! *Inside a frame rejected on a boundary* (row 14): a candidate that starts within the length
-//! the rejected frame's header promised, less [`MAX_DROPPED`] bytes it may have lost. A real
-//! frame starts there only if the rejected one lost more bytes than that.
+//! *Inside a frame rejected on a boundary* (rows 9 and 14): a candidate that starts within the
+//! length the rejected frame's header promised, less [`MAX_DROPPED`] bytes it may have lost. A
+//! real frame starts there only if the rejected one lost more bytes than that (a dropout), so a
+//! count that continues there is no evidence: a byte inserted into a frame leaves its last bytes
+//! and the next frame's header in the window, and payload bytes repeat counts.
+//!
+//! *Past a damaged next frame* (row 11): a reply nobody awaits on a certain boundary, whose next
+//! frame lost a byte inside (its count byte is then the next header's first), lost its header's
+//! first byte, or gained a byte, is taken when the frame right after the damaged one (where
+//! that damage puts it) continues its stream, the damaged frame counted as one of its stream.
+//! A damaged frame of the right length (a changed count byte) does not say which of the two is
+//! wrong, and does not vouch.
 //!
 //! *The chain vouches* ([`rules::Chain`]) when the frames right after the candidate, back to
 //! back, reach one whose count continues (or is near) its stream's count, counting the
@@ -653,9 +662,12 @@ impl DownlinkParser {
             }
             _ => match (frame.kind(), frame.seq()) {
                 (Kind::Telemetry(stream), Some(seq)) => match self.counts.rel(stream, seq, at) {
+                    // (Inside a frame rejected on a boundary, a continuing count is no
+                    // evidence: row 9.)
                     Rel::Continues | Rel::Near
                         if self.lock == Lock::Hunting
-                            && self.other_stream_fits(stream, seq, at) =>
+                            && (self.shadow > 0 && at == 0
+                                || self.other_stream_fits(stream, seq, at)) =>
                     {
                         Class::Ambiguous
                     }
@@ -785,6 +797,8 @@ impl DownlinkParser {
             0
         };
         let mut own_step: Option<(u8, u8)> = None;
+        // (Exact) a frame of the chain already passed over.
+        let mut skipped = false;
         loop {
             // The next frame's header: right at `pos`, or (first link of an exactly continuing
             // candidate) after up to two junk bytes.
@@ -810,7 +824,18 @@ impl DownlinkParser {
                 }
             }
             let Some((at, kind)) = found else {
-                return Ok(false);
+                // A reply nobody awaits, on a certain boundary, whose next frame lost its
+                // first byte: the frame after that one decides.
+                let lost_first = buf.get(pos).and_then(|second| stream_of_second(*second));
+                return match lost_first {
+                    Some(stream) if chain == Chain::Exact && !skipped => {
+                        let next = pos
+                            .saturating_sub(1)
+                            .saturating_add(Kind::Telemetry(stream).len());
+                        self.past_a_damaged_frame(buf, &counts, stream, [next, next], quiet)
+                    }
+                    _ => Ok(false),
+                };
             };
             let end = at.saturating_add(kind.len());
             let Some(bytes) = buf.get(at..end) else {
@@ -832,12 +857,19 @@ impl DownlinkParser {
                         // On a certain boundary, frames lost upstream.
                         Rel::Near => return Ok(self.lock == Lock::Locked),
                         Rel::Unknown => counts.take(stream, seq, false),
+                        // The next frame damaged (its count byte lost or changed): the frame
+                        // after it decides.
+                        Rel::Far if !skipped => {
+                            let places = [end.saturating_sub(1), end.saturating_add(1)];
+                            return self.past_a_damaged_frame(buf, &counts, stream, places, quiet);
+                        }
                         Rel::Far => return Ok(false),
                     },
                     _ => return Ok(false),
                 }
                 pos = end;
                 gap = 0;
+                skipped = true;
                 continue;
             }
             if let (Kind::Telemetry(stream), Some(seq)) = (next.kind(), next.seq()) {
@@ -876,6 +908,48 @@ impl DownlinkParser {
             pos = end;
             gap = 0;
         }
+    }
+
+    /// For a reply nobody awaits on a certain boundary (row 11) whose next frame is damaged:
+    /// whether a frame right after that one, at one of `places` (where it starts if the damaged
+    /// frame lost its header's first byte, or lost or gained a byte inside), continues its
+    /// stream's count.
+    #[inline(never)]
+    fn past_a_damaged_frame(
+        &self,
+        buf: &[u8],
+        counts: &Counts,
+        damaged: Stream,
+        places: [usize; 2],
+        quiet: bool,
+    ) -> Result<bool, usize> {
+        if self.lock != Lock::Locked {
+            return Ok(false);
+        }
+        let mut counts = *counts;
+        counts.passed(damaged);
+        for at in places {
+            let next = match (buf.get(at), buf.get(at.saturating_add(1))) {
+                (Some(a), Some(b)) => Kind::from_header(*a, *b),
+                _ if quiet => return Ok(false),
+                _ => return undecided(buf, at.saturating_add(2).saturating_sub(buf.len())),
+            };
+            let Some(Kind::Telemetry(stream)) = next else {
+                continue;
+            };
+            let end = at.saturating_add(Kind::Telemetry(stream).len());
+            let Some(seq) = buf.get(at.saturating_add(stream.seq_at())) else {
+                return if quiet || end > WINDOW {
+                    Ok(false)
+                } else {
+                    Err(end.saturating_sub(buf.len()))
+                };
+            };
+            if counts.rel(stream, *seq, at) == Rel::Continues {
+                return Ok(true);
+            }
+        }
+        Ok(false)
     }
 
     /// Drops the candidate's first byte and goes hunting.
@@ -1023,6 +1097,12 @@ fn holds_a_frame_start(bytes: &[u8]) -> bool {
     bytes
         .windows(2)
         .any(|pair| telemetry_header(pair).is_some())
+}
+
+/// The stream whose telemetry header ends with `second`, if one does.
+fn stream_of_second(second: u8) -> Option<Stream> {
+    let [sync, _] = telemetry::Imu::HEADER;
+    telemetry_header(&[sync, second])
 }
 
 /// The stream whose telemetry header `pair` is, if it is one.

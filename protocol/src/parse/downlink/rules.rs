@@ -11,8 +11,9 @@ pub enum Class {
     /// Telemetry whose count is a few steps on (frames lost).
     Near,
     /// Telemetry whose count continues (or is near) its stream's, but would continue another
-    /// stream's too: what a false frame in a damaged frame's tail, ending on that frame's count
-    /// byte, looks like when the streams share a counter or a time tick.
+    /// stream's too (what a false frame in a damaged frame's tail, ending on that frame's count
+    /// byte, looks like when the streams share a counter or a time tick), or that starts inside
+    /// a frame rejected on a boundary (where a continuing count is no evidence).
     Ambiguous,
     /// Telemetry of a stream with no count known (its first frame, or after forgetting).
     First,
@@ -101,13 +102,14 @@ pub const fn need(lock: Lock, class: Class) -> Need {
         (Lock::Tentative, Class::First | Class::Far) => Need::Chain(Chain::Rebase),
         // 8. Hunting, a plausible count: the next frames must vouch.
         (Lock::Hunting, Class::Continues | Class::Near) => Need::Chain(Chain::Verify),
-        // 9. Hunting, a stream's first frame, or a count another stream's could explain: its
-        //    own stream's next frame must continue it.
+        // 9. Hunting, a stream's first frame, a count another stream's could explain, or any
+        //    count inside a frame rejected on a boundary: its own stream's next frame must
+        //    continue it.
         (Lock::Hunting, Class::First | Class::Ambiguous) => Need::Chain(Chain::Own),
         // 10. Hunting, the awaited reply: the next frames (or the quiet line) must vouch.
         (Lock::Hunting, Class::Expected { .. }) => Need::Chain(Chain::Verify),
         // 11. A reply nobody waits for, on a boundary: the very next frame must continue its
-        //     count exactly.
+        //     count exactly (Locked: or, past a damaged next frame, the frame after it).
         (Lock::Locked | Lock::Tentative, Class::Unexpected) => Need::Chain(Chain::Exact),
         // 12. A reply nobody waits for, hunting: never (the tail of a damaged frame, `23` and a
         //     code in its payload, ends right where the next real frame starts).

@@ -84,6 +84,99 @@ fn a_reply_nobody_awaits_needs_the_next_count() {
     assert_eq!(out, vec![Downlink::Reply(reply), Downlink::Imu(imu(4, 0))]);
 }
 
+/// A parser locked on IMU frames 1..=3 is sent a reply nobody awaits, then IMU 4 damaged by
+/// `damage`, then IMU 5 and 6: what comes out, the line then going quiet.
+fn reply_then_damaged_frame(damage: impl FnOnce(&mut Vec<u8>)) -> Vec<Downlink> {
+    let mut p = locked();
+    let reply = Reply::new(Register::MaxSpeed, 500);
+    let mut damaged = imu(4, 0).encode().to_vec();
+    damage(&mut damaged);
+    let mut stream = reply.encode().to_vec();
+    stream.extend_from_slice(&damaged);
+    stream.extend_from_slice(&imu(5, 0).encode());
+    stream.extend_from_slice(&imu(6, 0).encode());
+    let mut out = feed(&mut p, &stream);
+    out.extend(drain_quiet(&mut p, 1));
+    out
+}
+
+#[test]
+fn a_reply_nobody_awaits_whose_next_frame_lost_a_byte_is_vouched_for_by_the_frame_after() {
+    let reply = Downlink::Reply(Reply::new(Register::MaxSpeed, 500));
+    // A byte lost inside the next frame, its first byte, or a byte gained inside it.
+    let lost_inside = reply_then_damaged_frame(|f| {
+        f.remove(7);
+    });
+    let lost_first = reply_then_damaged_frame(|f| {
+        f.remove(0);
+    });
+    let gained = reply_then_damaged_frame(|f| f.insert(9, 0x00));
+    for out in [lost_inside, lost_first, gained] {
+        assert_eq!(out.first(), Some(&reply), "{out:?}");
+        assert_eq!(seqs(&out), vec![5, 6]);
+    }
+}
+
+#[test]
+fn a_reply_nobody_awaits_whose_next_frame_is_not_continued_is_not_taken() {
+    // The next frame's count byte changed: the frame right after it, at its place, does not
+    // say which of the two is wrong (a false frame ends where the next real one starts).
+    let out = reply_then_damaged_frame(|f| {
+        if let Some(count) = f.last_mut() {
+            *count = 0x77;
+        }
+    });
+    assert_eq!(seqs(&out), vec![5, 6]);
+    assert!(
+        !out.iter().any(|f| matches!(f, Downlink::Reply(_))),
+        "{out:?}"
+    );
+}
+
+/// Row 9, inside a frame rejected on a boundary. IMU 4 gains a byte; its gyro X and Y then hold
+/// `FF FA` ten bytes in, and from there an "IMU frame" runs into encoder frame 24, whose fourth
+/// ticks' high byte makes its count 4: one on from IMU 3, and IMU 5, two junk bytes later,
+/// continues it. It starts inside the frame rejected on the boundary: its own stream's next
+/// frame must continue it right after it, and none does. The encoder frame comes out.
+#[test]
+fn row9_a_count_continuing_inside_a_rejected_frame_needs_its_own_stream() {
+    let imu = |seq: u8| Imu {
+        accel: [1, 2, 16_384],
+        gyro: [0x01FF, -0x0577, 0x0102],
+        seq,
+    };
+    let enc = |seq: u8| Encoders {
+        ticks: [10, 20, 30, 0x0411],
+        seq,
+    };
+    let mut p = DownlinkParser::new();
+    assert_eq!(p.quiet(1), None);
+    let mut wire = Vec::new();
+    let mut expected = Vec::new();
+    for seq in 1..=3 {
+        for frame in [Downlink::Imu(imu(seq)), Downlink::Encoders(enc(seq + 20))] {
+            wire.extend_from_slice(&frame.encode());
+            expected.push(frame);
+        }
+    }
+    let mut damaged = imu(4).encode().to_vec();
+    damaged.insert(3, 0x55);
+    assert_eq!(damaged.get(10..12), Some(&[0xFF, 0xFA][..]));
+    wire.extend_from_slice(&damaged);
+    for frame in [
+        Downlink::Encoders(enc(24)),
+        Downlink::Imu(imu(5)),
+        Downlink::Imu(imu(6)),
+        Downlink::Imu(imu(7)),
+    ] {
+        wire.extend_from_slice(&frame.encode());
+        expected.push(frame);
+    }
+    let mut out = feed(&mut p, &wire);
+    out.extend(drain_quiet(&mut p, 1));
+    assert_eq!(out, expected);
+}
+
 #[test]
 fn a_dropped_byte_loses_only_its_own_frame() {
     // From a quiet line: the stream's first frames come out at once.
