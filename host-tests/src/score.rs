@@ -4,7 +4,11 @@
 //!   at its place.
 //! * An emitted frame is **false** when it does not start where a sent frame of its kind
 //!   started. (A frame the channel damaged, emitted at its own place, is *damaged*, not false:
-//!   without a checksum nobody can tell.)
+//!   without a checksum nobody can tell.) One exception: a frame equal, byte for byte, to the
+//!   sent frame that ends where it ends is that frame, *damaged*, even if its first byte is not
+//!   the one the board sent: an `FF` inserted between a header's `FF` and its second byte, or a
+//!   header's `FF` lost right after a byte `FF`, leaves the frame's bytes whole behind another
+//!   `FF`. What comes out is what the board sent.
 //! * **Latency** is how many bytes after a frame's last byte the parser emitted it.
 
 use crate::board::{Gap, SentFrame};
@@ -91,6 +95,11 @@ pub fn score_downlink(sent: &[SentFrame], rx: &Received) -> Score {
 pub fn score_downlink_with_gaps(sent: &[SentFrame], rx: &Received, gaps: &[Gap]) -> Score {
     let by_start: HashMap<usize, usize> =
         sent.iter().enumerate().map(|(i, f)| (f.start, i)).collect();
+    let by_last: HashMap<usize, usize> = sent
+        .iter()
+        .enumerate()
+        .map(|(i, f)| (f.end().saturating_sub(1), i))
+        .collect();
     let mut emitted_at = vec![false; sent.len()];
     let mut score = Score {
         sent: sent.len(),
@@ -128,7 +137,21 @@ pub fn score_downlink_with_gaps(sent: &[SentFrame], rx: &Received, gaps: &[Gap])
                     score.damaged += 1;
                 }
             }
-            _ => score.false_frames += 1,
+            _ => {
+                // The sent frame's bytes, whole, behind another `FF` (see the module docs).
+                let whole = rx
+                    .origin
+                    .get(end)
+                    .copied()
+                    .flatten()
+                    .and_then(|last| by_last.get(&last))
+                    .is_some_and(|i| sent[*i].frame == frame);
+                if whole {
+                    score.damaged += 1;
+                } else {
+                    score.false_frames += 1;
+                }
+            }
         }
     };
 
@@ -276,6 +299,29 @@ mod tests {
             score.on_time_locked as f64 > 0.96 * score.recalled_locked as f64,
             "{score:?}"
         );
+    }
+
+    #[test]
+    fn a_sent_frame_whole_behind_an_inserted_ff_is_damaged_not_false() {
+        let (bytes, sent) = BoardStream::new(3, 2.0).take(200);
+        let clean = transmit(&bytes, &Noise::default(), &mut Pcg64Mcg::seed_from_u64(0));
+        // An `FF` inserted between the header bytes of an IMU frame well into the stream.
+        let imu = sent
+            .iter()
+            .skip(100)
+            .find(|f| matches!(f.frame, Downlink::Imu(_)))
+            .expect("an IMU frame");
+        let at = imu.start + 1;
+        let mut rx = clean.clone();
+        rx.bytes.insert(at, 0xFF);
+        rx.origin.insert(at, None);
+        rx.touched[at] = true;
+        rx.errors = 1;
+        let score = score_downlink(&sent, &rx);
+        assert_eq!(score.untouched, 199);
+        assert_eq!(score.false_frames, 0, "{score:?}");
+        assert_eq!(score.damaged, 1, "{score:?}");
+        assert_eq!(score.recalled, 199, "{score:?}");
     }
 
     #[test]
