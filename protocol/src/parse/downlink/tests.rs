@@ -136,8 +136,9 @@ fn a_reply_nobody_awaits_whose_next_frame_is_not_continued_is_not_taken() {
 /// Row 9, inside a frame rejected on a boundary. IMU 4 gains a byte; its gyro X and Y then hold
 /// `FF FA` ten bytes in, and from there an "IMU frame" runs into encoder frame 24, whose fourth
 /// ticks' high byte makes its count 4: one on from IMU 3, and IMU 5, two junk bytes later,
-/// continues it. It starts inside the frame rejected on the boundary: its own stream's next
-/// frame must continue it right after it, and none does. The encoder frame comes out.
+/// continues it. It starts inside the frame rejected on the boundary: the frames right after it
+/// must reach one of its own stream continuing it, and two junk bytes follow it. The encoder
+/// frame comes out.
 #[test]
 fn row9_a_count_continuing_inside_a_rejected_frame_needs_its_own_stream() {
     let imu = |seq: u8| Imu {
