@@ -473,9 +473,42 @@ impl DownlinkParser {
                         }
                     }
                 }
+                if let Some(more) = self.unawaited_reply_waits(kind, self.buf.as_slice()) {
+                    self.wait_for(more);
+                    return None;
+                }
             }
         }
         self.run(false)
+    }
+
+    /// Row 11's first two judgements without the general judgement: a reply nobody awaits, on
+    /// a boundary, whose next frame's header has not come yet waits for it (two bytes), and
+    /// with that header waits for the rest of that frame. `None`: anything else.
+    fn unawaited_reply_waits(&self, kind: Kind, bytes: &[u8]) -> Option<usize> {
+        // (What row 11 needs, whatever kind of boundary.)
+        const _: () = assert!(matches!(
+            (
+                rules::need(Lock::Locked, Class::Unexpected),
+                rules::need(Lock::Tentative, Class::Unexpected),
+            ),
+            (Need::Chain(Chain::Exact), Need::Chain(Chain::Exact))
+        ));
+        if kind != Kind::Reply || self.lock == Lock::Hunting {
+            return None;
+        }
+        let code = bytes.get(1).copied();
+        if code.is_none() || self.expect == code {
+            return None;
+        }
+        match bytes.get(kind.len()..)? {
+            [] => Some(2),
+            [first, second] => {
+                let next = Kind::from_header(*first, *second)?;
+                Some(next.len().saturating_sub(2)).filter(|n| *n > 0)
+            }
+            _ => None,
+        }
     }
 
     /// Row 1 for `frame`, whose bytes are alone in the window or, the window empty, about to be
