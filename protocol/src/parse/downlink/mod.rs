@@ -497,8 +497,8 @@ impl DownlinkParser {
         if kind != Kind::Reply || self.lock == Lock::Hunting {
             return None;
         }
-        let code = bytes.get(1).copied();
-        if code.is_none() || self.expect == code {
+        let code = bytes.get(1).copied()?;
+        if self.expect == Some(code) {
             return None;
         }
         match bytes.get(kind.len()..)? {
@@ -865,7 +865,7 @@ impl DownlinkParser {
                         let next = pos
                             .saturating_sub(1)
                             .saturating_add(Kind::Telemetry(stream).len());
-                        self.past_a_damaged_frame(buf, &counts, stream, [next, next], quiet)
+                        self.past_a_damaged_frame(buf, &counts, stream, &[next], quiet)
                     }
                     _ => Ok(false),
                 };
@@ -894,7 +894,7 @@ impl DownlinkParser {
                         // after it decides.
                         Rel::Far if !skipped => {
                             let places = [end.saturating_sub(1), end.saturating_add(1)];
-                            return self.past_a_damaged_frame(buf, &counts, stream, places, quiet);
+                            return self.past_a_damaged_frame(buf, &counts, stream, &places, quiet);
                         }
                         Rel::Far => return Ok(false),
                     },
@@ -953,7 +953,7 @@ impl DownlinkParser {
         buf: &[u8],
         counts: &Counts,
         damaged: Stream,
-        places: [usize; 2],
+        places: &[usize],
         quiet: bool,
     ) -> Result<bool, usize> {
         if self.lock != Lock::Locked {
@@ -961,7 +961,7 @@ impl DownlinkParser {
         }
         let mut counts = *counts;
         counts.passed(damaged);
-        for at in places {
+        for &at in places {
             let next = match (buf.get(at), buf.get(at.saturating_add(1))) {
                 (Some(a), Some(b)) => Kind::from_header(*a, *b),
                 _ if quiet => return Ok(false),
