@@ -67,6 +67,43 @@ pub struct Gap {
     pub ms: u32,
 }
 
+/// A read the master sent, as the master knows it: its reply is awaited from the sent byte at
+/// `from` until the one at `until` (the reply timeout), unless it comes first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Read {
+    /// Offset in the sent stream from which the reply is awaited.
+    pub from: usize,
+    /// Offset in the sent stream at which the master gives up waiting.
+    pub until: usize,
+    /// The register read.
+    pub register: Register,
+}
+
+/// The driver's reply timeout at 115 200 bps (55 ms), in bytes of line time (11.52 per ms).
+pub const READ_TIMEOUT_BYTES: usize = 55 * 11_520 / 1_000;
+
+/// The reads behind the replies in `sent`, as the master that sent them knows them (what the
+/// driver tells its parser, and what a capture decoded with its master → board side shows).
+/// Each reply is awaited from the start of the frame sent before it (the board finishes the
+/// frame it is sending, then answers), until [`READ_TIMEOUT_BYTES`] after that.
+pub fn reads_behind(sent: &[SentFrame]) -> Vec<Read> {
+    let mut reads = Vec::new();
+    let mut before = 0usize;
+    for f in sent {
+        if let Downlink::Reply(reply) = f.frame {
+            if let Some(register) = reply.register() {
+                reads.push(Read {
+                    from: before,
+                    until: before + READ_TIMEOUT_BYTES,
+                    register,
+                });
+            }
+        }
+        before = f.start;
+    }
+    reads
+}
+
 /// The board's telemetry generator.
 #[derive(Clone, Debug)]
 pub struct BoardStream {

@@ -11,7 +11,7 @@
 //!   `FF`. What comes out is what the board sent.
 //! * **Latency** is how many bytes after a frame's last byte the parser emitted it.
 
-use crate::board::{Gap, SentFrame};
+use crate::board::{Gap, Read, SentFrame};
 use crate::channel::Received;
 use chassis_protocol::{Downlink, DownlinkParser, DownlinkStats, Lock};
 use std::collections::HashMap;
@@ -93,6 +93,18 @@ pub fn score_downlink(sent: &[SentFrame], rx: &Received) -> Score {
 /// ([`DownlinkParser::quiet`], with its length) before the first received byte that was sent
 /// after it.
 pub fn score_downlink_with_gaps(sent: &[SentFrame], rx: &Received, gaps: &[Gap]) -> Score {
+    score_downlink_listening(sent, rx, gaps, &[])
+}
+
+/// [`score_downlink_with_gaps`], with the parser also told of every read the master sent
+/// ([`DownlinkParser::expect_reply`]) before the first received byte sent from the read's
+/// `from` on, and told it gave up waiting (`None`) at its `until`, as the driver does.
+pub fn score_downlink_listening(
+    sent: &[SentFrame],
+    rx: &Received,
+    gaps: &[Gap],
+    reads: &[Read],
+) -> Score {
     let by_start: HashMap<usize, usize> =
         sent.iter().enumerate().map(|(i, f)| (f.start, i)).collect();
     let by_last: HashMap<usize, usize> = sent
@@ -158,6 +170,8 @@ pub fn score_downlink_with_gaps(sent: &[SentFrame], rx: &Received, gaps: &[Gap])
     // Whether the parser was Locked when each received byte arrived.
     let mut locked_at = Vec::with_capacity(rx.bytes.len());
     let mut gaps = gaps.iter().peekable();
+    let mut reads = reads.iter().peekable();
+    let mut awaited: Option<Read> = None;
     for (now, byte) in rx.bytes.iter().enumerate() {
         if let Some(origin) = rx.origin.get(now).copied().flatten() {
             let mut quiet_ms = 0;
@@ -176,6 +190,14 @@ pub fn score_downlink_with_gaps(sent: &[SentFrame], rx: &Received, gaps: &[Gap])
                         &mut score,
                     );
                 }
+            }
+            while let Some(read) = reads.next_if(|r| r.from <= origin) {
+                parser.expect_reply(Some(read.register));
+                awaited = Some(*read);
+            }
+            if awaited.is_some_and(|r| r.until <= origin) {
+                parser.expect_reply(None);
+                awaited = None;
             }
         }
         locked_at.push(parser.lock() == Lock::Locked);

@@ -35,18 +35,24 @@
 //! | 7 | Tentative | telemetry, the stream's first or a far count | when the chain vouches (far counts in it re-based), or it fills the burst up to the next quiet line |
 //! | 8 | Hunting | telemetry, count continues or near (and fits no other stream) | when the chain vouches |
 //! | 9 | Hunting | telemetry, the stream's first, a count another stream's could explain, or any count inside a frame rejected on a boundary | when its own stream's next frame in the chain continues it |
-//! | 10 | Hunting | the awaited reply | when the chain (or a quiet line) vouches |
+//! | 10 | Hunting | the awaited reply, not inside a frame rejected on a boundary | when the chain (or a quiet line) vouches, and the chain holds no other reply with its code |
 //! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it); Locked, past a damaged next frame, when the frame after it continues |
-//! | 12 | Hunting | a reply nobody awaits | never |
+//! | 12 | Hunting | a reply nobody awaits, or the awaited code inside a frame rejected on a boundary | never |
 //! | 13 | Hunting | telemetry, count far | when its own stream's next three frames in the chain move on from it in step (the board restarted its counts) |
 //! | 14 | Hunting, inside a frame rejected on a boundary | telemetry whose last bytes are a whole frame of another stream, whose count fits that stream | never (the scan reaches the inner frame next) |
 //! | 15 | any | telemetry, count far, its last two bytes a telemetry header (a cut frame running into the next one) | never |
 //!
-//! *Inside a frame rejected on a boundary* (rows 9 and 14): a candidate that starts within the
-//! length the rejected frame's header promised, less [`MAX_DROPPED`] bytes it may have lost. A
-//! real frame starts there only if the rejected one lost more bytes than that (a dropout), so a
-//! count that continues there is no evidence: a byte inserted into a frame leaves its last bytes
-//! and the next frame's header in the window, and payload bytes repeat counts.
+//! *Inside a frame rejected on a boundary* (rows 9, 12 and 14): a candidate that starts within
+//! the length the rejected frame's header promised, less [`MAX_DROPPED`] bytes it may have lost.
+//! A real frame starts there only if the rejected one lost more bytes than that (a dropout), so
+//! a count that continues there is no evidence: a byte inserted into a frame leaves its last
+//! bytes and the next frame's header in the window, and payload bytes repeat counts. Nor is the
+//! awaited reply's code: `23` and a code in a damaged frame's payload end on its count byte,
+//! right where the next frame starts, so the chain after it vouches as well as for a real one.
+//!
+//! *The master asked once* (row 10): a chain after the awaited reply that holds another reply
+//! with the same code (the real one, after a `23` and the code in a damaged frame's tail) does
+//! not vouch for it.
 //!
 //! *Past a damaged next frame* (row 11): a reply nobody awaits on a certain boundary, whose next
 //! frame lost a byte inside (its count byte is then the next header's first), lost its header's
@@ -682,9 +688,16 @@ impl DownlinkParser {
     /// What the candidate `frame`, starting `at` bytes into the window, is.
     fn class(&self, frame: &Downlink, at: usize) -> Class {
         match frame {
-            Downlink::Reply(reply) if self.expect == Some(reply.code) => Class::Expected {
-                clean: !holds_a_frame_start(reply.encode().get(2..).unwrap_or(&[])),
-            },
+            // (Inside a frame rejected on a boundary, the awaited code is no evidence either:
+            // row 12.)
+            Downlink::Reply(reply)
+                if self.expect == Some(reply.code)
+                    && !(self.lock == Lock::Hunting && self.shadow > 0 && at == 0) =>
+            {
+                Class::Expected {
+                    clean: !holds_a_frame_start(reply.encode().get(2..).unwrap_or(&[])),
+                }
+            }
             Downlink::Reply(_) => Class::Unexpected,
             _ if self.lock == Lock::Hunting
                 && self.shadow > 0
@@ -881,6 +894,14 @@ impl DownlinkParser {
             let Ok(next) = Downlink::decode(bytes) else {
                 return Ok(false);
             };
+            // The master asked once: an awaited reply whose chain holds another reply with the
+            // same code is not the answer (a `23` and the code in a damaged frame's tail, the
+            // real reply further on).
+            if matches!(class, Class::Expected { .. })
+                && matches!(next, Downlink::Reply(reply) if self.expect == Some(reply.code))
+            {
+                return Ok(false);
+            }
             if chain == Chain::Exact {
                 // Only the next frame, continuing exactly; a stream's first frame (no count to
                 // judge by) is passed over, a reply is not.

@@ -25,7 +25,8 @@ pub enum Class {
         /// No `FF FA`..`FF FC` inside its value.
         clean: bool,
     },
-    /// A reply the master is not waiting for (or a parser told nothing).
+    /// A reply the master is not waiting for (or a parser told nothing), or the awaited code
+    /// found while hunting inside a frame rejected on a boundary.
     Unexpected,
     /// Telemetry whose count is far and whose last two bytes are a telemetry header: a frame
     /// cut short that runs into the next frame's header, its "count" the header's second byte
@@ -106,13 +107,15 @@ pub const fn need(lock: Lock, class: Class) -> Need {
         //    count inside a frame rejected on a boundary: its own stream's next frame must
         //    continue it.
         (Lock::Hunting, Class::First | Class::Ambiguous) => Need::Chain(Chain::Own),
-        // 10. Hunting, the awaited reply: the next frames (or the quiet line) must vouch.
+        // 10. Hunting, the awaited reply (not inside a frame rejected on a boundary): the next
+        //     frames (or the quiet line) must vouch, and hold no other reply with its code.
         (Lock::Hunting, Class::Expected { .. }) => Need::Chain(Chain::Verify),
         // 11. A reply nobody waits for, on a boundary: the very next frame must continue its
         //     count exactly (Locked: or, past a damaged next frame, the frame after it).
         (Lock::Locked | Lock::Tentative, Class::Unexpected) => Need::Chain(Chain::Exact),
-        // 12. A reply nobody waits for, hunting: never (the tail of a damaged frame, `23` and a
-        //     code in its payload, ends right where the next real frame starts).
+        // 12. A reply nobody waits for (or the awaited code inside a frame rejected on a
+        //     boundary), hunting: never (the tail of a damaged frame, `23` and a code in its
+        //     payload, ends right where the next real frame starts).
         (Lock::Hunting, Class::Unexpected) => Need::Never,
         // 13. Hunting, a far count: its own stream's next three frames must move on from it in
         //     step (a board that restarted its counts).

@@ -490,3 +490,43 @@ fn under_a_shared_counter_the_imus_step_after_an_encoder_frame_is_learnt() {
     // lost); from the second on, +2 is a step: on their last byte.
     assert_eq!(late, vec![5, 9]);
 }
+
+#[test]
+fn row12_the_awaited_code_inside_a_frame_rejected_on_a_boundary_is_not_the_reply() {
+    let mut p = locked();
+    p.expect_reply(Some(Register::PendingAngle));
+    // IMU 4 (gyro X 0x0023, gyro Y 0x2000, gyro Z 5) with its fourth byte lost: its last six
+    // bytes, `23 20 00 00 05 04`, read as the awaited reply (code 0x20) ending on its count
+    // byte, right where IMU 5 starts.
+    let damaged = [
+        0xFF, 0xFA, 0x00, /* 0x01 lost */ 0xFF, 0xFE, 0x40, 0x00, 0x00, 0x23, 0x20, 0x00,
+        0x00, 0x05, 0x04,
+    ];
+    let mut out = feed(&mut p, &damaged);
+    out.extend(feed(&mut p, &imu(5, 0).encode()));
+    out.extend(feed(&mut p, &imu(6, 0).encode()));
+    out.extend(drain_quiet(&mut p, 1));
+    assert!(
+        !out.iter().any(|f| matches!(f, Downlink::Reply(_))),
+        "{out:?}"
+    );
+    assert_eq!(seqs(&out), vec![5, 6]);
+}
+
+#[test]
+fn row10_an_awaited_reply_whose_chain_holds_another_with_its_code_is_not_the_answer() {
+    let mut p = DownlinkParser::new();
+    p.expect_reply(Some(Register::PendingAngle));
+    // Junk with `23 20` in it, then the real reply (pending angle 42), then a quiet line.
+    let mut out = feed(
+        &mut p,
+        &[
+            0x23, 0x20, 0x01, 0x02, 0x03, 0x04, 0x23, 0x20, 0x00, 0x00, 0x00, 0x2A,
+        ],
+    );
+    out.extend(drain_quiet(&mut p, 5));
+    assert_eq!(
+        out,
+        vec![Downlink::Reply(Reply::new(Register::PendingAngle, 42))]
+    );
+}
