@@ -5,7 +5,8 @@
 //! byte offset of the frame's first byte in the input) and `"frame"`, the fields of its kind,
 //! and `"t"` (seconds) when the capture has time stamps.
 
-use chassis_protocol::{Command, Downlink, DownlinkParser, Setting, UplinkParser};
+use chassis_protocol::driver::Config;
+use chassis_protocol::{Command, Downlink, DownlinkParser, Register, Setting, UplinkParser};
 use serde_json::{Value, json};
 
 /// How the input is written.
@@ -191,90 +192,187 @@ pub struct Decoded {
 
 /// Decodes `capture` (board → master, or master → board with `uplink`).
 pub fn decode(capture: &Capture, uplink: bool) -> Decoded {
-    let mut out = Decoded::default();
-    let mut search_from = 0usize;
-    let mut place = |wire: &[u8], upto: usize| -> usize {
-        // The frame's bytes, from where the previous frame ended up to the byte that let it
-        // out: the parser emits frames in order and never two from the same bytes.
-        let end = upto.min(capture.bytes.len());
-        let found = capture
-            .bytes
-            .get(search_from..end)
-            .and_then(|hay| hay.windows(wire.len()).position(|w| w == wire))
-            .map(|p| p + search_from)
-            .unwrap_or(search_from);
-        search_from = found + wire.len();
-        found
-    };
-    let time_of = |offset: usize| capture.times.as_ref().and_then(|t| t.get(offset).copied());
-    let gap_before = |i: usize| -> Option<u32> {
-        let times = capture.times.as_ref()?;
-        let (a, b) = (times.get(i.checked_sub(1)?)?, times.get(i)?);
-        let gap = b - a;
-        (gap > QUIET_GAP_S).then(|| (gap * 1000.0).round().clamp(1.0, 60_000.0) as u32)
-    };
-    if uplink {
-        let mut parser = UplinkParser::new();
-        for (i, &byte) in capture.bytes.iter().enumerate() {
-            if gap_before(i).is_some() {
-                parser.idle();
-            }
-            if let Some(command) = parser.push(byte) {
-                let (json, text) = describe_uplink(&command);
-                // Encoding consumes the command (a turn is sent once, even in a decoder).
-                let wire = command.encode();
-                let offset = place(wire.as_slice(), i + 1);
-                out.frames.push(found(offset, time_of(offset), json, &text));
-            }
-        }
-        let s = parser.stats();
-        out.summary = format!(
-            "{} bytes: {} frames; {} bytes discarded, {} resyncs",
-            capture.bytes.len(),
-            s.frames,
-            s.discarded,
-            s.resyncs
-        );
+    let (frames, summary) = if uplink {
+        let (frames, _, summary) = decode_uplink(capture);
+        (frames, summary)
     } else {
-        let mut parser = DownlinkParser::new();
-        let mut emit = |frame: Downlink, upto: usize, out: &mut Decoded| {
-            let (json, text) = describe_downlink(&frame);
-            let offset = place(frame.encode().as_slice(), upto);
-            out.frames.push(found(offset, time_of(offset), json, &text));
-        };
-        for (i, &byte) in capture.bytes.iter().enumerate() {
-            if let Some(ms) = gap_before(i) {
-                while let Some(frame) = parser.quiet(ms) {
-                    emit(frame, i, &mut out);
-                }
-            }
-            if let Some(frame) = parser.push(byte) {
-                emit(frame, i + 1, &mut out);
-            }
-            while let Some(frame) = parser.poll() {
-                emit(frame, i + 1, &mut out);
-            }
-        }
-        // The end of a capture is a quiet line.
-        while let Some(frame) = parser.quiet(1_000) {
-            emit(frame, capture.bytes.len(), &mut out);
-        }
-        let s = parser.stats();
-        let gaps: u32 = s.gaps.iter().sum();
-        let missed: u32 = s.missed.iter().sum();
-        out.summary = format!(
-            "{} bytes: imu {}, encoders {}, battery {}, reply {}; {} bytes discarded; {} count gaps ({} frames missed)",
-            capture.bytes.len(),
-            s.frames[0],
-            s.frames[1],
-            s.frames[2],
-            s.frames[3],
-            s.discarded,
-            gaps,
-            missed
+        decode_downlink(capture, &[])
+    };
+    Decoded { frames, summary }
+}
+
+/// Decodes both sides of one capture, `board` (board → master) and `master` (master → board),
+/// both time-stamped: each read the master sent tells the board side's parser which reply is
+/// awaited from the read's last byte on (until the driver's reply timeout), as the driver does.
+/// The frames of both sides come out in time order, each with `"from"`: `"board"` or
+/// `"master"` (offsets are into its own side's input).
+pub fn decode_both(board: &Capture, master: &Capture) -> Result<Decoded, String> {
+    let (Some(_), Some(master_times)) = (&board.times, &master.times) else {
+        return Err(
+            "--master needs the time of every byte on both sides, to line them up: \
+                    export each side as an async-serial CSV and give --input saleae-csv"
+                .into(),
         );
+    };
+    let (master_frames, reads, master_summary) = decode_uplink(master);
+    let reads: Vec<(f64, Register)> = reads
+        .iter()
+        .filter_map(|(last, register)| Some((*master_times.get(*last)?, *register)))
+        .collect();
+    let (board_frames, board_summary) = decode_downlink(board, &reads);
+    let mut frames: Vec<(f64, u8, Found)> = Vec::new();
+    for (side, list, name) in [(0u8, board_frames, "board"), (1, master_frames, "master")] {
+        for mut found in list {
+            let t = found.json.get("t").and_then(Value::as_f64).unwrap_or(0.0);
+            if let Some(map) = found.json.as_object_mut() {
+                map.insert("from".into(), json!(name));
+            }
+            found.text = format!("{name:<6} {}", found.text);
+            frames.push((t, side, found));
+        }
     }
-    out
+    // Stable: frames of one side keep their order; at the same instant the board's first.
+    frames.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    Ok(Decoded {
+        frames: frames.into_iter().map(|(_, _, f)| f).collect(),
+        summary: format!(
+            "board: {board_summary}; master: {master_summary}; {} reads told the board side's parser which reply to await",
+            reads.len()
+        ),
+    })
+}
+
+/// Places each frame a parser emits in its input: the frame's bytes, searched from where the
+/// previous frame ended up to the byte that let it out (the parsers emit frames in order and
+/// never two from the same bytes).
+struct Placer<'a> {
+    bytes: &'a [u8],
+    search_from: usize,
+}
+
+impl Placer<'_> {
+    fn place(&mut self, wire: &[u8], upto: usize) -> usize {
+        let end = upto.min(self.bytes.len());
+        let found = self
+            .bytes
+            .get(self.search_from..end)
+            .and_then(|hay| hay.windows(wire.len()).position(|w| w == wire))
+            .map(|p| p + self.search_from)
+            .unwrap_or(self.search_from);
+        self.search_from = found + wire.len();
+        found
+    }
+}
+
+/// The time of byte `offset`, if the capture has times.
+fn time_of(capture: &Capture, offset: usize) -> Option<f64> {
+    capture.times.as_ref().and_then(|t| t.get(offset).copied())
+}
+
+/// How long the line was quiet before byte `i`, in ms, if longer than [`QUIET_GAP_S`].
+fn gap_before(capture: &Capture, i: usize) -> Option<u32> {
+    let times = capture.times.as_ref()?;
+    let (a, b) = (times.get(i.checked_sub(1)?)?, times.get(i)?);
+    let gap = b - a;
+    (gap > QUIET_GAP_S).then(|| (gap * 1000.0).round().clamp(1.0, 60_000.0) as u32)
+}
+
+/// The master → board side: its frames, each read (the index of its last byte and the register
+/// read), and the summary.
+fn decode_uplink(capture: &Capture) -> (Vec<Found>, Vec<(usize, Register)>, String) {
+    let mut frames = Vec::new();
+    let mut reads = Vec::new();
+    let mut placer = Placer {
+        bytes: &capture.bytes,
+        search_from: 0,
+    };
+    let mut parser = UplinkParser::new();
+    for (i, &byte) in capture.bytes.iter().enumerate() {
+        if gap_before(capture, i).is_some() {
+            parser.idle();
+        }
+        if let Some(command) = parser.push(byte) {
+            if let Command::Setting(Setting::Read(register)) = command {
+                reads.push((i, register));
+            }
+            let (json, text) = describe_uplink(&command);
+            // Encoding consumes the command (a turn is sent once, even in a decoder).
+            let wire = command.encode();
+            let offset = placer.place(wire.as_slice(), i + 1);
+            frames.push(found(offset, time_of(capture, offset), json, &text));
+        }
+    }
+    let s = parser.stats();
+    let summary = format!(
+        "{} bytes: {} frames; {} bytes discarded, {} resyncs",
+        capture.bytes.len(),
+        s.frames,
+        s.discarded,
+        s.resyncs
+    );
+    (frames, reads, summary)
+}
+
+/// The board → master side, the parser told of each read in `reads` (the time of its last
+/// byte, in the capture's clock, and the register) from the first byte received after it.
+fn decode_downlink(capture: &Capture, reads: &[(f64, Register)]) -> (Vec<Found>, String) {
+    let mut frames = Vec::new();
+    let mut placer = Placer {
+        bytes: &capture.bytes,
+        search_from: 0,
+    };
+    let timeout_s = f64::from(Config::DEFAULT.reply_timeout_ms()) / 1000.0;
+    let mut reads = reads.iter().peekable();
+    // The read awaited, and when the master gives up on it.
+    let mut awaited: Option<f64> = None;
+    let mut parser = DownlinkParser::new();
+    let mut emit = |frame: Downlink, upto: usize, frames: &mut Vec<Found>| {
+        let (json, text) = describe_downlink(&frame);
+        let offset = placer.place(frame.encode().as_slice(), upto);
+        frames.push(found(offset, time_of(capture, offset), json, &text));
+    };
+    for (i, &byte) in capture.bytes.iter().enumerate() {
+        if let Some(ms) = gap_before(capture, i) {
+            while let Some(frame) = parser.quiet(ms) {
+                emit(frame, i, &mut frames);
+            }
+        }
+        if let Some(now) = time_of(capture, i) {
+            while let Some((sent, register)) = reads.next_if(|(t, _)| *t <= now) {
+                parser.expect_reply(Some(*register));
+                awaited = Some(sent + timeout_s);
+            }
+            if awaited.is_some_and(|deadline| now > deadline) {
+                parser.expect_reply(None);
+                awaited = None;
+            }
+        }
+        if let Some(frame) = parser.push(byte) {
+            emit(frame, i + 1, &mut frames);
+        }
+        while let Some(frame) = parser.poll() {
+            emit(frame, i + 1, &mut frames);
+        }
+    }
+    // The end of a capture is a quiet line.
+    while let Some(frame) = parser.quiet(1_000) {
+        emit(frame, capture.bytes.len(), &mut frames);
+    }
+    let s = parser.stats();
+    let gaps: u32 = s.gaps.iter().sum();
+    let missed: u32 = s.missed.iter().sum();
+    let summary = format!(
+        "{} bytes: imu {}, encoders {}, battery {}, reply {}; {} bytes discarded; {} count gaps ({} frames missed)",
+        capture.bytes.len(),
+        s.frames[0],
+        s.frames[1],
+        s.frames[2],
+        s.frames[3],
+        s.discarded,
+        gaps,
+        missed
+    );
+    (frames, summary)
 }
 
 /// A frame's description placed in the input: `offset` (and `t`) added to its JSON, the offset

@@ -36,6 +36,11 @@ enum Cmd {
         /// The master → board direction.
         #[arg(long)]
         uplink: bool,
+        /// The master → board side of the same capture (both sides time-stamped: --input
+        /// saleae-csv). Its reads tell the board side's parser which reply is awaited, as the
+        /// driver does; the frames of both sides come out in time order, each with "from".
+        #[arg(long, value_name = "FILE", conflicts_with = "uplink")]
+        master: Option<String>,
         /// How the capture is written.
         #[arg(long, value_enum, default_value = "raw")]
         input: decode::Input,
@@ -126,6 +131,20 @@ fn main() -> ExitCode {
     }
 }
 
+/// The bytes of `file` (`None` or "-": standard input).
+fn read_input(file: Option<&str>) -> Result<Vec<u8>, String> {
+    match file {
+        None | Some("-") => {
+            let mut data = Vec::new();
+            std::io::stdin()
+                .read_to_end(&mut data)
+                .map_err(|e| format!("standard input: {e}"))?;
+            Ok(data)
+        }
+        Some(path) => std::fs::read(path).map_err(|e| format!("cannot read {path}: {e}")),
+    }
+}
+
 fn port(cli_port: Option<&str>) -> Result<&str, String> {
     cli_port.ok_or_else(|| "this command talks to a board: give its serial port with --port PATH (or try `chassis sim --pty`)".to_string())
 }
@@ -136,23 +155,25 @@ fn run(cli: Cli) -> Result<(), String> {
         Cmd::Decode {
             file,
             uplink,
+            master,
             input,
             format,
         } => {
-            let data = match file.as_deref() {
-                None | Some("-") => {
-                    let mut data = Vec::new();
-                    std::io::stdin()
-                        .read_to_end(&mut data)
-                        .map_err(|e| format!("standard input: {e}"))?;
-                    data
-                }
+            if master.is_some()
+                && (master.as_deref() == Some("-") || file.as_deref().is_none_or(|f| f == "-"))
+            {
+                return Err(
+                    "--master: give both sides as files (standard input is one stream)".into(),
+                );
+            }
+            let capture = decode::read_capture(&read_input(file.as_deref())?, input)?;
+            let decoded = match master {
                 Some(path) => {
-                    std::fs::read(path).map_err(|e| format!("cannot read {path}: {e}"))?
+                    let master = decode::read_capture(&read_input(Some(&path))?, input)?;
+                    decode::decode_both(&capture, &master)?
                 }
+                None => decode::decode(&capture, uplink),
             };
-            let capture = decode::read_capture(&data, input)?;
-            let decoded = decode::decode(&capture, uplink);
             let stdout = std::io::stdout();
             let mut out = std::io::BufWriter::new(stdout.lock());
             for found in &decoded.frames {
