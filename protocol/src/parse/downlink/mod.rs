@@ -871,8 +871,14 @@ impl DownlinkParser {
             }
             let Some((at, kind)) = found else {
                 // A reply nobody awaits, on a certain boundary, whose next frame lost its
-                // first byte: the frame after that one decides.
-                let lost_first = buf.get(pos).and_then(|second| stream_of_second(*second));
+                // first byte: the frame after that one decides. Unless the reply's last byte
+                // is that first byte (`FF`): the next frame's header is then whole, a byte
+                // early, and it is the reply that lost a byte.
+                let [sync, _] = telemetry::Imu::HEADER;
+                let lost_first = buf
+                    .get(pos)
+                    .and_then(|second| stream_of_second(*second))
+                    .filter(|_| buf.get(pos.wrapping_sub(1)) != Some(&sync));
                 return match lost_first {
                     Some(stream) if chain == Chain::Exact && !skipped => {
                         let next = pos

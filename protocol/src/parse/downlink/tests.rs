@@ -530,3 +530,18 @@ fn row10_an_awaited_reply_whose_chain_holds_another_with_its_code_is_not_the_ans
         vec![Downlink::Reply(Reply::new(Register::PendingAngle, 42))]
     );
 }
+
+#[test]
+fn row11_a_reply_nobody_awaits_ending_in_the_next_headers_first_byte_lost_a_byte_itself() {
+    let mut p = locked();
+    // The reply `23 01 00 00 01 F4` (maximum speed 500) lost its last byte; IMU 4 and 5 follow
+    // whole. Six bytes from the `23` end in IMU 4's `FF`: read as a whole reply whose next
+    // frame lost its first byte, IMU 5 (one step on from the IMU 4 "damaged") would vouch for
+    // it. But IMU 4's header is whole a byte early: it is the reply that is short.
+    let mut stream = vec![0x23, 0x01, 0x00, 0x00, 0x01];
+    stream.extend_from_slice(&imu(4, 0).encode());
+    stream.extend_from_slice(&imu(5, 0).encode());
+    let mut out = feed(&mut p, &stream);
+    out.extend(drain_quiet(&mut p, 1));
+    assert_eq!(out, vec![imu(4, 0).into(), imu(5, 0).into()]);
+}
