@@ -90,6 +90,42 @@ pub fn parse_hex(data: &[u8]) -> Result<Vec<u8>, String> {
 /// A Saleae async-serial export: a header naming a time column (`Time [s]`, `start_time`) and
 /// a byte column (`Value`, `data`), then one row per byte.
 pub fn parse_saleae(data: &[u8]) -> Result<Capture, String> {
+    parse_saleae_rows(data, |_| true)
+}
+
+/// One Saleae Logic 2 export holding both sides of a capture (one async-serial analyser per
+/// line, told apart by the `name` column): the board side (every analyser but `master`) and
+/// the master side (the analyser named `master`).
+pub fn parse_saleae_sides(data: &[u8], master: &str) -> Result<(Capture, Capture), String> {
+    let text = std::str::from_utf8(data).map_err(|_| "CSV input: not text".to_string())?;
+    let header = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+    let name_col = split_csv(header)
+        .iter()
+        .position(|c| c.trim().eq_ignore_ascii_case("name"))
+        .ok_or_else(|| {
+            format!(
+                "--master-analyzer: the CSV has no \"name\" column (its header is {header:?}): \
+                 export both analysers from Logic 2's data table, or each side to its own file \
+                 and give --master FILE"
+            )
+        })?;
+    let is_master = |fields: &[String]| {
+        fields
+            .get(name_col)
+            .is_some_and(|n| n.trim() == master.trim())
+    };
+    let board = parse_saleae_rows(data, |f| !is_master(f))?;
+    let master_side = parse_saleae_rows(data, is_master)?;
+    if master_side.bytes.is_empty() {
+        return Err(format!(
+            "--master-analyzer: no row of the CSV comes from an analyser named {master:?}"
+        ));
+    }
+    Ok((board, master_side))
+}
+
+/// [`parse_saleae`], keeping only the rows `keep` accepts (given the row's fields).
+fn parse_saleae_rows(data: &[u8], keep: impl Fn(&[String]) -> bool) -> Result<Capture, String> {
     let text = std::str::from_utf8(data).map_err(|_| "CSV input: not text".to_string())?;
     let mut lines = text
         .lines()
@@ -119,6 +155,9 @@ pub fn parse_saleae(data: &[u8]) -> Result<Capture, String> {
     };
     for (line_no, line) in lines {
         let fields = split_csv(line);
+        if !keep(&fields) {
+            continue;
+        }
         // Logic 2 exports errors and other rows with a type other than "data".
         if let Some(t) = type_col.and_then(|i| fields.get(i)) {
             if !t.trim().eq_ignore_ascii_case("data") {

@@ -41,6 +41,14 @@ enum Cmd {
         /// driver does; the frames of both sides come out in time order, each with "from".
         #[arg(long, value_name = "FILE", conflicts_with = "uplink")]
         master: Option<String>,
+        /// Both sides in one Saleae Logic 2 export: the rows of the analyser named NAME are
+        /// the master → board side, the others the board's (as --master FILE).
+        #[arg(
+            long,
+            value_name = "NAME",
+            conflicts_with_all = ["uplink", "master"]
+        )]
+        master_analyzer: Option<String>,
         /// How the capture is written.
         #[arg(long, value_enum, default_value = "raw")]
         input: decode::Input,
@@ -131,6 +139,25 @@ fn main() -> ExitCode {
     }
 }
 
+/// Writes the frames found, one per line, and the summary on stderr.
+fn write_decoded(decoded: &decode::Decoded, format: decode::Format) -> Result<(), String> {
+    let stdout = std::io::stdout();
+    let mut out = std::io::BufWriter::new(stdout.lock());
+    for found in &decoded.frames {
+        let line = match format {
+            decode::Format::Json => found.json.to_string(),
+            decode::Format::Text => found.text.clone(),
+        };
+        if writeln!(out, "{line}").is_err() {
+            // A closed pipe (`| head`): stop quietly.
+            return Ok(());
+        }
+    }
+    let _ = out.flush();
+    eprintln!("chassis decode: {}", decoded.summary);
+    Ok(())
+}
+
 /// The bytes of `file` (`None` or "-": standard input).
 fn read_input(file: Option<&str>) -> Result<Vec<u8>, String> {
     match file {
@@ -156,6 +183,7 @@ fn run(cli: Cli) -> Result<(), String> {
             file,
             uplink,
             master,
+            master_analyzer,
             input,
             format,
         } => {
@@ -166,7 +194,19 @@ fn run(cli: Cli) -> Result<(), String> {
                     "--master: give both sides as files (standard input is one stream)".into(),
                 );
             }
-            let capture = decode::read_capture(&read_input(file.as_deref())?, input)?;
+            if master_analyzer.is_some() && input != decode::Input::SaleaeCsv {
+                return Err(
+                    "--master-analyzer reads a Saleae Logic 2 export: give --input saleae-csv"
+                        .into(),
+                );
+            }
+            let data = read_input(file.as_deref())?;
+            if let Some(name) = master_analyzer {
+                let (board, master) = decode::parse_saleae_sides(&data, &name)?;
+                let decoded = decode::decode_both(&board, &master)?;
+                return write_decoded(&decoded, format);
+            }
+            let capture = decode::read_capture(&data, input)?;
             let decoded = match master {
                 Some(path) => {
                     let master = decode::read_capture(&read_input(Some(&path))?, input)?;
@@ -174,21 +214,7 @@ fn run(cli: Cli) -> Result<(), String> {
                 }
                 None => decode::decode(&capture, uplink),
             };
-            let stdout = std::io::stdout();
-            let mut out = std::io::BufWriter::new(stdout.lock());
-            for found in &decoded.frames {
-                let line = match format {
-                    decode::Format::Json => found.json.to_string(),
-                    decode::Format::Text => found.text.clone(),
-                };
-                if writeln!(out, "{line}").is_err() {
-                    // A closed pipe (`| head`): stop quietly.
-                    return Ok(());
-                }
-            }
-            let _ = out.flush();
-            eprintln!("chassis decode: {}", decoded.summary);
-            Ok(())
+            write_decoded(&decoded, format)
         }
         Cmd::Encode { frame } => {
             println!("{}", encode::hex(&encode::encode(&frame)?));

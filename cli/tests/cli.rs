@@ -136,6 +136,53 @@ fn decode_both_sides_of_a_capture() {
 }
 
 #[test]
+fn decode_both_sides_from_one_logic2_export() {
+    // The same capture as `decode_both_sides_of_a_capture`, as Logic 2 exports two analysers
+    // ("board" and "master") in one data table.
+    let both = golden("both_logic2.csv");
+    let out = chassis(&[
+        "decode",
+        both.as_str(),
+        "--master-analyzer",
+        "master",
+        "--input",
+        "saleae-csv",
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let got = json_lines(&String::from_utf8_lossy(&out.stdout));
+    let want = json_lines(&std::fs::read_to_string(golden("both.jsonl")).unwrap());
+    assert_eq!(got, want);
+
+    assert_clear_error(
+        &chassis(&[
+            "decode",
+            both.as_str(),
+            "--master-analyzer",
+            "tx",
+            "--input",
+            "saleae-csv",
+        ]),
+        "no row",
+    );
+    let logic1 = golden("uplink_logic1.csv");
+    assert_clear_error(
+        &chassis(&[
+            "decode",
+            logic1.as_str(),
+            "--master-analyzer",
+            "master",
+            "--input",
+            "saleae-csv",
+        ]),
+        "name",
+    );
+    assert_clear_error(
+        &chassis(&["decode", both.as_str(), "--master-analyzer", "master"]),
+        "saleae-csv",
+    );
+}
+
+#[test]
 fn decode_raw_bytes_from_standard_input() {
     // The hex golden file's bytes, raw, through a pipe.
     let hex = std::fs::read_to_string(golden("downlink.hex")).unwrap();
