@@ -31,6 +31,16 @@ fn json_lines(text: &str) -> Vec<Value> {
         .collect()
 }
 
+/// `chassis args` succeeds and writes the JSON lines of the golden file `expected`.
+fn assert_decodes_to(args: &[&str], expected: &str) -> Output {
+    let out = chassis(args);
+    assert!(out.status.success(), "{out:?}");
+    let got = json_lines(&String::from_utf8_lossy(&out.stdout));
+    let want = json_lines(&std::fs::read_to_string(golden(expected)).unwrap());
+    assert_eq!(got, want, "{expected}");
+    out
+}
+
 /// One line on stderr, a non-zero exit, nothing on stdout.
 fn assert_clear_error(out: &Output, needle: &str) {
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -84,18 +94,17 @@ fn decode_both_sides_of_a_capture() {
     // is damaged, row 11) and drops it; with the master's side, the reply is awaited and taken.
     let board = golden("both_board_logic2.csv");
     let master = golden("both_master_logic1.csv");
-    let out = chassis(&[
-        "decode",
-        board.as_str(),
-        "--master",
-        master.as_str(),
-        "--input",
-        "saleae-csv",
-    ]);
-    assert!(out.status.success(), "{out:?}");
-    let got = json_lines(&String::from_utf8_lossy(&out.stdout));
-    let want = json_lines(&std::fs::read_to_string(golden("both.jsonl")).unwrap());
-    assert_eq!(got, want);
+    let out = assert_decodes_to(
+        &[
+            "decode",
+            board.as_str(),
+            "--master",
+            master.as_str(),
+            "--input",
+            "saleae-csv",
+        ],
+        "both.jsonl",
+    );
     let summary = String::from_utf8_lossy(&out.stderr);
     assert!(summary.contains("reply 1"), "{summary}");
     assert!(summary.contains("1 reads told"), "{summary}");
@@ -140,18 +149,17 @@ fn decode_both_sides_from_one_logic2_export() {
     // The same capture as `decode_both_sides_of_a_capture`, as Logic 2 exports two analysers
     // ("board" and "master") in one data table.
     let both = golden("both_logic2.csv");
-    let out = chassis(&[
-        "decode",
-        both.as_str(),
-        "--master-analyzer",
-        "master",
-        "--input",
-        "saleae-csv",
-    ]);
-    assert!(out.status.success(), "{out:?}");
-    let got = json_lines(&String::from_utf8_lossy(&out.stdout));
-    let want = json_lines(&std::fs::read_to_string(golden("both.jsonl")).unwrap());
-    assert_eq!(got, want);
+    assert_decodes_to(
+        &[
+            "decode",
+            both.as_str(),
+            "--master-analyzer",
+            "master",
+            "--input",
+            "saleae-csv",
+        ],
+        "both.jsonl",
+    );
 
     assert_clear_error(
         &chassis(&[

@@ -158,14 +158,7 @@ fn main() -> ExitCode {
         ),
         ("dropouts of 32, 1e-4", Noise::dropouts(1e-4, 32)),
     ];
-    let mut worst: Option<(f64, f64, String)> = None;
-    model_rows(&args, &channels, false, &mut worst);
-    if let Some((false_per_million, recall, row)) = worst {
-        println!(
-            "\nWorst row: {row}: {false_per_million:.1} false frames per million, recall {:.3} %",
-            -recall * 100.0
-        );
-    }
+    model_rows(&args, &channels, false, "Worst row");
 
     // The same stream models with the master's side known: the parser told of each read the
     // master sent (the driver does this; so does `chassis decode --master`).
@@ -177,14 +170,7 @@ fn main() -> ExitCode {
         "| payload | count model | quiet reported | channel | recall | false/M | lost/error | on time while locked |"
     );
     println!("|---|---|---|---|---|---|---|---|");
-    let mut worst: Option<(f64, f64, String)> = None;
-    model_rows(&args, &channels, true, &mut worst);
-    if let Some((false_per_million, recall, row)) = worst {
-        println!(
-            "\nWorst row with the reads known: {row}: {false_per_million:.1} false frames per million, recall {:.3} %",
-            -recall * 100.0
-        );
-    }
+    model_rows(&args, &channels, true, "Worst row with the reads known");
 
     // The same channel over the board simulator's own output (telemetry at real rates, a read
     // every half second answered while telemetry pauses).
@@ -228,13 +214,9 @@ fn main() -> ExitCode {
 }
 
 /// One row per stream model and channel: payloads, every count model, quiet reported or not;
-/// with `reads`, the parser is told of the master's reads. Keeps the worst row in `worst`.
-fn model_rows(
-    args: &Args,
-    channels: &[(&str, Noise)],
-    reads: bool,
-    worst: &mut Option<(f64, f64, String)>,
-) {
+/// with `reads`, the parser is told of the master's reads. Then the worst row, after `label`.
+fn model_rows(args: &Args, channels: &[(&str, Noise)], reads: bool, label: &str) {
+    let mut worst: Option<(f64, f64, String)> = None;
     for (payload_name, payload) in [
         ("at rest", Payload::Rest),
         ("adversarial", Payload::Adversarial),
@@ -272,10 +254,16 @@ fn model_rows(
                     );
                     let key = (s.false_per_million(), -s.recall());
                     if worst.as_ref().is_none_or(|w| key > (w.0, w.1)) {
-                        *worst = Some((key.0, key.1, row));
+                        worst = Some((key.0, key.1, row));
                     }
                 }
             }
         }
+    }
+    if let Some((false_per_million, recall, row)) = worst {
+        println!(
+            "\n{label}: {row}: {false_per_million:.1} false frames per million, recall {:.3} %",
+            -recall * 100.0
+        );
     }
 }
