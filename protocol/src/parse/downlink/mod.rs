@@ -39,8 +39,17 @@
 //! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it); Locked, past a damaged next frame, when the frame after it continues |
 //! | 12 | Hunting | a reply nobody awaits, or the awaited code inside a frame rejected on a boundary | never |
 //! | 13 | Hunting | telemetry, count far | when its own stream's next three frames in the chain move on from it in step (the board restarted its counts) |
-//! | 14 | Hunting, inside a frame rejected on a boundary | telemetry whose last bytes are a whole frame of another stream, whose count fits that stream | never (the scan reaches the inner frame next) |
+//! | 14 | Hunting | telemetry whose last bytes are a frame of another stream that lost or gained a byte, or, inside a frame rejected on a boundary, a whole one; ending on the same count byte, which fits that stream | never (a whole inner frame: the scan reaches it next) |
 //! | 15 | any | telemetry, count far, its last two bytes a telemetry header (a cut frame running into the next one) | never |
+//!
+//! *A frame of another stream that lost or gained a byte* (row 14): its header inside the
+//! candidate, where a frame of its stream one byte shorter (or longer) ends on the candidate's
+//! count byte, and that count fits its stream: a damaged real frame, behind bytes that happen to
+//! hold a header (under one counter shared by all streams, or a time tick, the count fits the
+//! outer stream too, and the frames after it continue both). The inner frame cannot be taken
+//! itself, so rejecting the outer one lets nothing false through. (A *whole* inner frame outside
+//! a rejected frame is not enough: measured, rejecting the outer frame there cost recall and let
+//! the inner, false, one through.)
 //!
 //! *Inside a frame rejected on a boundary* (rows 9, 12 and 14): a candidate that starts within
 //! the length the rejected frame's header promised, less [`MAX_DROPPED`] bytes it may have lost.
@@ -700,9 +709,9 @@ impl DownlinkParser {
             }
             Downlink::Reply(_) => Class::Unexpected,
             _ if self.lock == Lock::Hunting
-                && self.shadow > 0
                 && at == 0
-                && self.nests_a_frame(frame) =>
+                && (self.shadow > 0 && self.nests_a_frame(frame, &[0])
+                    || self.nests_a_frame(frame, &[1, -1])) =>
             {
                 Class::Nested
             }
@@ -739,18 +748,23 @@ impl DownlinkParser {
             .is_some()
     }
 
-    /// Whether the telemetry candidate `frame` at the front of the window ends with a whole
-    /// frame of another stream whose count continues (or is near) that stream's.
-    fn nests_a_frame(&self, frame: &Downlink) -> bool {
-        let (Kind::Telemetry(_), Some(seq)) = (frame.kind(), frame.seq()) else {
+    /// Whether the telemetry candidate `frame` at the front of the window ends with a frame of
+    /// another stream whose count (the candidate's) continues (or is near) that stream's; that
+    /// frame's bytes there number its length plus one of `damage` (0: whole; -1: it lost a
+    /// byte; 1: it gained one).
+    fn nests_a_frame(&self, frame: &Downlink, damage: &[i8]) -> bool {
+        let (Kind::Telemetry(outer), Some(seq)) = (frame.kind(), frame.seq()) else {
             return false;
         };
         let len = frame.kind().len();
         let bytes = self.buf.as_slice().get(..len).unwrap_or(&[]);
-        // (A frame of the same stream has the same length: only another stream's ends there.)
         bytes.windows(2).enumerate().skip(1).any(|(off, pair)| {
             telemetry_header(pair).is_some_and(|inner| {
-                Kind::Telemetry(inner).len() == len.saturating_sub(off)
+                let inner_len = Kind::Telemetry(inner).len();
+                inner != outer
+                    && damage.iter().any(|d| {
+                        inner_len.saturating_add_signed(isize::from(*d)) == len.saturating_sub(off)
+                    })
                     && matches!(self.counts.rel(inner, seq, off), Rel::Continues | Rel::Near)
             })
         })

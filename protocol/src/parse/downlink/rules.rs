@@ -32,11 +32,12 @@ pub enum Class {
     /// cut short that runs into the next frame's header, its "count" the header's second byte
     /// (`FA`, `FB`, `FC` are consecutive, so two such cuts in a row look like a count moving on).
     Cut,
-    /// Found while hunting inside a frame rejected on a boundary (see the module docs, row
-    /// 14): telemetry whose last bytes are a whole frame of another stream, ending on the same
-    /// count byte, whose count fits that stream. The damaged frame's tail with a header in its
-    /// payload, then the real frame: both cannot be real, and the inner one, which starts with
-    /// its own header, is judged on its own when the scan reaches it.
+    /// Found while hunting (see the module docs, row 14): telemetry whose last bytes are a
+    /// frame of another stream that lost or gained a byte, or, inside a frame rejected on a
+    /// boundary, a whole one; ending on the same count byte, whose count fits that stream.
+    /// Bytes that happen to hold a header, then the real frame: both cannot be real, and a
+    /// whole inner one, which starts with its own header, is judged on its own when the scan
+    /// reaches it.
     Nested,
 }
 
@@ -120,9 +121,10 @@ pub const fn need(lock: Lock, class: Class) -> Need {
         // 13. Hunting, a far count: its own stream's next three frames must move on from it in
         //     step (a board that restarted its counts).
         (Lock::Hunting, Class::Far) => Need::Chain(Chain::Restart),
-        // 14. Hunting inside a frame rejected on a boundary, a whole frame of another stream
-        //     fills the candidate's tail, its count fitting: never (the scan reaches the inner
-        //     frame next). Only ever found while hunting.
+        // 14. Hunting, a frame of another stream that lost or gained a byte (or, inside a
+        //     frame rejected on a boundary, a whole one) fills the candidate's tail, its count
+        //     fitting: never (a whole inner frame: the scan reaches it next). Only ever found
+        //     while hunting.
         (_, Class::Nested) => Need::Never,
         // 15. A far count that is a header's second byte (the frame ends with a header): never.
         (_, Class::Cut) => Need::Never,

@@ -545,3 +545,43 @@ fn row11_a_reply_nobody_awaits_ending_in_the_next_headers_first_byte_lost_a_byte
     out.extend(drain_quiet(&mut p, 1));
     assert_eq!(out, vec![imu(4, 0).into(), imu(5, 0).into()]);
 }
+
+#[test]
+fn row14_hunting_a_frame_whose_tail_is_another_streams_frame_that_lost_a_byte_is_never_taken() {
+    let enc = |seq| Encoders { ticks: [0; 4], seq };
+    let mut p = locked();
+    let mut out = feed(&mut p, &enc(5).encode());
+    out.extend(feed(&mut p, &imu(4, 0).encode()));
+    // IMU 5 (gyro Y -6, gyro Z 0) with three bytes gained after its header: rejected on its
+    // boundary, the parser hunts past it.
+    let damaged_imu = [
+        0xFF, 0xFA, 0x00, 0x00, 0x00, 0x00, 0x01, 0x00, 0x02, 0x40, 0x00, 0x00, 0x00, 0xFF, 0xFA,
+        0x00, 0x00, 0x05,
+    ];
+    // Encoder frame 6 with one of its tick bytes lost: ten bytes.
+    let damaged_enc = [0xFF, 0xFB, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x06];
+    // IMU 5's last five bytes (`FF FA 00 00 05`) and the damaged encoder frame read as an IMU
+    // frame with count 6 (one frame on from IMU 4), and IMU 7 would continue it.
+    out.extend(feed(&mut p, &damaged_imu));
+    out.extend(feed(&mut p, &damaged_enc));
+    for seq in [7, 8] {
+        out.extend(feed(&mut p, &imu(seq, 0).encode()));
+    }
+    out.extend(feed(&mut p, &enc(7).encode()));
+    out.extend(feed(&mut p, &imu(9, 0).encode()));
+    out.extend(drain_quiet(&mut p, 1));
+    assert!(
+        !out.iter()
+            .any(|f| matches!(f, Downlink::Imu(imu) if imu.seq == 6)),
+        "{out:?}"
+    );
+    let want: Vec<Downlink> = vec![
+        enc(5).into(),
+        imu(4, 0).into(),
+        imu(7, 0).into(),
+        imu(8, 0).into(),
+        enc(7).into(),
+        imu(9, 0).into(),
+    ];
+    assert_eq!(out, want);
+}
