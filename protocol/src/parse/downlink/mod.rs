@@ -39,7 +39,7 @@
 //! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it); Locked, past a damaged next frame, when the frame after it continues |
 //! | 12 | Hunting | a reply nobody awaits, or the awaited code inside a frame rejected on a boundary | never |
 //! | 13 | Hunting | telemetry, count far | when its own stream's next three frames in the chain move on from it in step (the board restarted its counts) |
-//! | 14 | Hunting | telemetry whose last bytes are a frame of another stream that lost or gained a byte, or, inside a frame rejected on a boundary, a whole one; ending on the same count byte, which fits that stream | never (a whole inner frame: the scan reaches it next) |
+//! | 14 | Hunting | telemetry whose last bytes are a frame of another stream that lost or gained a byte, or, inside a frame rejected on a boundary and with a count not near its own stream's, a whole one; ending on the same count byte, which fits that stream; or telemetry that is the tail of a frame of another stream that lost its first byte | never (a whole inner frame: the scan reaches it next) |
 //! | 15 | any | telemetry, count far, its last two bytes a telemetry header (a cut frame running into the next one) | never |
 //!
 //! *A frame of another stream that lost or gained a byte* (row 14): its header inside the
@@ -49,7 +49,14 @@
 //! outer stream too, and the frames after it continue both). The inner frame cannot be taken
 //! itself, so rejecting the outer one lets nothing false through. (A *whole* inner frame outside
 //! a rejected frame is not enough: measured, rejecting the outer frame there cost recall and let
-//! the inner, false, one through.)
+//! the inner, false, one through.) Inside a frame rejected on a boundary, the outer frame is
+//! judged by a whole inner one only when its own count is not near: a frame cut short by a
+//! dropout leaves the next whole frames in its length, with counts a few frames on.
+//!
+//! *The tail of a frame that lost its first byte* (row 14): a lone `FA`..`FC` among the bytes
+//! thrown away right before the candidate (not after an `FF`), where the rest of a frame of that
+//! stream ends on the candidate's count byte, which fits that stream: an encoder frame's header
+//! in an IMU frame's payload (accel Y of -5) whose own `FF` was lost.
 //!
 //! *Inside a frame rejected on a boundary* (rows 9, 12 and 14): a candidate that starts within
 //! the length the rejected frame's header promised, less [`MAX_DROPPED`] bytes it may have lost.
@@ -299,11 +306,15 @@ pub struct DownlinkParser {
     missing: u8,
     /// Start positions still inside the frame last rejected on a boundary (row 14).
     shadow: u8,
+    /// The bytes thrown away right before the window's first byte, newest in the low byte
+    /// (row 14: a frame that lost its first byte), and how many of them there are.
+    before: u32,
+    before_len: u8,
     stats: DownlinkStats,
 }
 
 const _: () = assert!(
-    core::mem::size_of::<DownlinkParser>() <= 216,
+    core::mem::size_of::<DownlinkParser>() <= 220,
     "DownlinkParser over its RAM budget"
 );
 
@@ -327,6 +338,8 @@ impl DownlinkParser {
             since_frame: 0,
             missing: 0,
             shadow: 0,
+            before: 0,
+            before_len: 0,
             stats: DownlinkStats::new(),
         }
     }
@@ -367,7 +380,7 @@ impl DownlinkParser {
                 [] => {
                     // A byte that starts no frame, with nothing before it: thrown away at once.
                     if !Kind::may_start(byte) {
-                        self.discard();
+                        self.discard(byte);
                         return None;
                     }
                     if self.buf.push(byte) {
@@ -418,8 +431,8 @@ impl DownlinkParser {
             if self.buf.len() == 0 {
                 let junk = bytes.iter().take_while(|b| !Kind::may_start(**b)).count();
                 if junk > 0 {
-                    for _ in 0..junk {
-                        self.discard();
+                    for byte in bytes.iter().take(junk) {
+                        self.discard(*byte);
                     }
                     bytes = bytes.get(junk..).unwrap_or(&[]);
                     continue;
@@ -584,6 +597,7 @@ impl DownlinkParser {
         if frame.is_none() {
             self.counts.quiet(ms);
             self.shadow = 0;
+            self.before_len = 0;
             if self.lock == Lock::Hunting && !cut {
                 self.lock = Lock::Tentative;
             }
@@ -710,8 +724,9 @@ impl DownlinkParser {
             Downlink::Reply(_) => Class::Unexpected,
             _ if self.lock == Lock::Hunting
                 && at == 0
-                && (self.shadow > 0 && self.nests_a_frame(frame, &[0])
-                    || self.nests_a_frame(frame, &[1, -1])) =>
+                && (self.shadow > 0 && !self.near(frame) && self.nests_a_frame(frame, &[0])
+                    || self.nests_a_frame(frame, &[1, -1])
+                    || self.inside_a_headless_frame(frame)) =>
             {
                 Class::Nested
             }
@@ -768,6 +783,48 @@ impl DownlinkParser {
                     && matches!(self.counts.rel(inner, seq, off), Rel::Continues | Rel::Near)
             })
         })
+    }
+
+    /// Whether the telemetry candidate `frame` at the front of the window is the tail of a
+    /// frame of another stream that lost its first byte: that frame's second header byte
+    /// (`FA`..`FC`, not after an `FF`; after a frame taken or a quiet line, the byte before it
+    /// is not known) among the bytes thrown away right before it, where the rest of that frame
+    /// ends on the candidate's count byte, which fits that stream.
+    fn inside_a_headless_frame(&self, frame: &Downlink) -> bool {
+        let (Kind::Telemetry(own), Some(seq)) = (frame.kind(), frame.seq()) else {
+            return false;
+        };
+        let len = frame.kind().len();
+        // The byte `back` bytes before the window's first, if it was seen.
+        let before = |back: usize| {
+            (back >= 1 && back <= usize::from(self.before_len)).then(|| {
+                let shift = back.saturating_sub(1).saturating_mul(8);
+                self.before
+                    .checked_shr(u32::try_from(shift).unwrap_or(u32::MAX))
+                    .unwrap_or(0) as u8
+            })
+        };
+        let [sync, _] = telemetry::Imu::HEADER;
+        Stream::ALL.iter().any(|outer| {
+            // The outer frame less its first byte ends where the candidate ends.
+            let back = Kind::Telemetry(*outer)
+                .len()
+                .saturating_sub(1)
+                .saturating_sub(len);
+            *outer != own
+                && back > 0
+                && before(back).and_then(stream_of_second) == Some(*outer)
+                && before(back.saturating_add(1)) != Some(sync)
+                && matches!(self.counts.rel(*outer, seq, 0), Rel::Continues | Rel::Near)
+        })
+    }
+
+    /// Whether the telemetry `frame` at the front of the window has a near count.
+    fn near(&self, frame: &Downlink) -> bool {
+        match (frame.kind(), frame.seq()) {
+            (Kind::Telemetry(stream), Some(seq)) => self.counts.rel(stream, seq, 0) == Rel::Near,
+            _ => false,
+        }
     }
 
     /// Whether `seq` would continue (or be near) a stream other than `stream`.
@@ -1036,15 +1093,19 @@ impl DownlinkParser {
             }
             _ => None,
         };
+        let first = self.buf.as_slice().first().copied().unwrap_or(0);
         self.buf.drop_front(1);
-        self.discard();
+        self.discard(first);
         if let Some(shadow) = shadow {
             self.shadow = u8::try_from(shadow).unwrap_or(u8::MAX);
         }
     }
 
-    /// Counts one byte thrown away (already out of the window, or never in it).
-    fn discard(&mut self) {
+    /// Counts one byte thrown away (already out of the window, or never in it): `byte`, the
+    /// one right before the window's first byte now.
+    fn discard(&mut self, byte: u8) {
+        self.before = self.before << 8 | u32::from(byte);
+        self.before_len = self.before_len.saturating_add(1).min(4);
         self.consumed(1);
         self.counts.discarded();
         self.stats.discarded = self.stats.discarded.wrapping_add(1);
@@ -1124,6 +1185,7 @@ impl DownlinkParser {
         self.counts.bytes(len);
         self.since_frame = 0;
         self.shadow = 0;
+        self.before_len = 0;
         self.stats.count_frame(kind);
         if self.lock == Lock::Hunting {
             self.stats.resyncs = self.stats.resyncs.wrapping_add(1);

@@ -34,10 +34,11 @@ pub enum Class {
     Cut,
     /// Found while hunting (see the module docs, row 14): telemetry whose last bytes are a
     /// frame of another stream that lost or gained a byte, or, inside a frame rejected on a
-    /// boundary, a whole one; ending on the same count byte, whose count fits that stream.
-    /// Bytes that happen to hold a header, then the real frame: both cannot be real, and a
-    /// whole inner one, which starts with its own header, is judged on its own when the scan
-    /// reaches it.
+    /// boundary (its own count not near), a whole one; ending on the same count byte, whose
+    /// count fits that stream. Bytes that happen to hold a header, then the real frame: both
+    /// cannot be real, and a whole inner one, which starts with its own header, is judged on
+    /// its own when the scan reaches it. Or telemetry that is the tail of a frame of another
+    /// stream that lost its first byte (its lone second header byte just before).
     Nested,
 }
 
@@ -123,8 +124,8 @@ pub const fn need(lock: Lock, class: Class) -> Need {
         (Lock::Hunting, Class::Far) => Need::Chain(Chain::Restart),
         // 14. Hunting, a frame of another stream that lost or gained a byte (or, inside a
         //     frame rejected on a boundary, a whole one) fills the candidate's tail, its count
-        //     fitting: never (a whole inner frame: the scan reaches it next). Only ever found
-        //     while hunting.
+        //     fitting; or the candidate is the tail of a frame that lost its first byte: never
+        //     (a whole inner frame: the scan reaches it next). Only ever found while hunting.
         (_, Class::Nested) => Need::Never,
         // 15. A far count that is a header's second byte (the frame ends with a header): never.
         (_, Class::Cut) => Need::Never,

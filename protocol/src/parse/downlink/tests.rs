@@ -585,3 +585,65 @@ fn row14_hunting_a_frame_whose_tail_is_another_streams_frame_that_lost_a_byte_is
     ];
     assert_eq!(out, want);
 }
+
+#[test]
+fn row14_after_a_dropout_a_whole_frame_with_a_near_count_is_not_judged_by_its_tail() {
+    let enc = |seq| Encoders { ticks: [0; 4], seq };
+    let mut p = locked();
+    let mut out = feed(&mut p, &enc(5).encode());
+    out.extend(feed(&mut p, &imu(4, 0).encode()));
+    // A dropout: IMU 5's first six bytes, then nothing until IMU 7 (IMU 6 lost whole). IMU 7
+    // starts inside the frame cut short (rejected on its boundary), and its accel Y is -5
+    // (`FF FB`): its last eleven bytes read as encoder frame 7, continuing encoder frame 5.
+    // IMU 7's own count is near (two frames lost): it is a real frame, not a tail.
+    let imu7 = Imu {
+        accel: [1, -5, 16_384],
+        gyro: [0, 0, 0],
+        seq: 7,
+    };
+    out.extend(feed(&mut p, &[0xFF, 0xFA, 0x00, 0x01, 0xFF, 0xFE]));
+    out.extend(feed(&mut p, &imu7.encode()));
+    for seq in [8, 9] {
+        out.extend(feed(&mut p, &imu(seq, 0).encode()));
+    }
+    out.extend(drain_quiet(&mut p, 1));
+    let want: Vec<Downlink> = vec![
+        enc(5).into(),
+        imu(4, 0).into(),
+        imu7.into(),
+        imu(8, 0).into(),
+        imu(9, 0).into(),
+    ];
+    assert_eq!(out, want);
+}
+
+#[test]
+fn row14_hunting_the_tail_of_a_frame_that_lost_its_first_byte_is_never_taken() {
+    let enc = |seq| Encoders { ticks: [0; 4], seq };
+    let mut p = locked();
+    let mut out = Vec::new();
+    for seq in 4..=6 {
+        out.extend(feed(&mut p, &enc(seq).encode()));
+        out.extend(feed(&mut p, &imu(seq, 0).encode()));
+    }
+    // IMU 7 (accel Y -5: `FF FB`) lost its first byte. Its last eleven bytes read as encoder
+    // frame 7, continuing encoder frame 6, and encoder frame 8 after IMU 8 would continue them;
+    // but the lone `FA` three bytes before them is the header of an IMU frame whose rest ends
+    // on that same count byte.
+    let imu7 = Imu {
+        accel: [1, -5, 16_384],
+        gyro: [0, 0, 0],
+        seq: 7,
+    };
+    out.extend(feed(&mut p, &imu7.encode()[1..]));
+    out.extend(feed(&mut p, &imu(8, 0).encode()));
+    out.extend(feed(&mut p, &enc(8).encode()));
+    out.extend(feed(&mut p, &imu(9, 0).encode()));
+    out.extend(drain_quiet(&mut p, 1));
+    let mut want: Vec<Downlink> = Vec::new();
+    for seq in 4..=6 {
+        want.extend([Downlink::from(enc(seq)), imu(seq, 0).into()]);
+    }
+    want.extend([Downlink::from(imu(8, 0)), enc(8).into(), imu(9, 0).into()]);
+    assert_eq!(out, want);
+}
