@@ -329,8 +329,10 @@ pub mod budget {
     pub const PROTOCOL_GOAL: u64 = 4 * 1024;
     /// What parsers + builders may not grow past: a regression guard until the goal above is
     /// met. Set at 10 KiB (measured 9 348 B); raised to 11 KiB when the parser learnt to take
-    /// a reply nobody awaits past a damaged frame (10 776 B): recall was below its goal.
-    pub const PROTOCOL_CEILING: u64 = 11 * 1024;
+    /// a reply nobody awaits past a damaged frame (10 776 B): recall was below its goal; raised
+    /// to 12 KiB when row 14 learnt damaged inner frames and the tail of a frame that lost its
+    /// first byte (11 600 B, about 440 B of judgement): false frames were above their goal.
+    pub const PROTOCOL_CEILING: u64 = 12 * 1024;
 }
 
 /// Builds the probes and the bring-up firmware, prints the table, returns whether every
