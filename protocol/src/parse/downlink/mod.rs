@@ -773,15 +773,26 @@ impl DownlinkParser {
         };
         let len = frame.kind().len();
         let bytes = self.buf.as_slice().get(..len).unwrap_or(&[]);
-        bytes.windows(2).enumerate().skip(1).any(|(off, pair)| {
-            telemetry_header(pair).is_some_and(|inner| {
-                let inner_len = Kind::Telemetry(inner).len();
-                inner != outer
-                    && damage.iter().any(|d| {
-                        inner_len.saturating_add_signed(isize::from(*d)) == len.saturating_sub(off)
-                    })
-                    && matches!(self.counts.rel(inner, seq, off), Rel::Continues | Rel::Near)
-            })
+        // Only the places where such a frame would start are looked at.
+        Stream::ALL.iter().any(|inner| {
+            *inner != outer
+                && damage.iter().any(|d| {
+                    let inner_len = Kind::Telemetry(*inner)
+                        .len()
+                        .saturating_add_signed(isize::from(*d));
+                    len.checked_sub(inner_len)
+                        .filter(|off| *off > 0)
+                        .is_some_and(|off| {
+                            bytes
+                                .get(off..off.saturating_add(2))
+                                .and_then(telemetry_header)
+                                == Some(*inner)
+                                && matches!(
+                                    self.counts.rel(*inner, seq, off),
+                                    Rel::Continues | Rel::Near
+                                )
+                        })
+                })
         })
     }
 
@@ -797,7 +808,7 @@ impl DownlinkParser {
         let len = frame.kind().len();
         // The byte `back` bytes before the window's first, if it was seen.
         let before = |back: usize| {
-            (back >= 1 && back <= usize::from(self.before_len)).then(|| {
+            ((1..=4).contains(&back) && back <= usize::from(self.before_len)).then(|| {
                 let shift = back.saturating_sub(1).saturating_mul(8);
                 self.before
                     .checked_shr(u32::try_from(shift).unwrap_or(u32::MAX))
@@ -1105,7 +1116,7 @@ impl DownlinkParser {
     /// one right before the window's first byte now.
     fn discard(&mut self, byte: u8) {
         self.before = self.before << 8 | u32::from(byte);
-        self.before_len = self.before_len.saturating_add(1).min(4);
+        self.before_len = self.before_len.saturating_add(1);
         self.consumed(1);
         self.counts.discarded();
         self.stats.discarded = self.stats.discarded.wrapping_add(1);
