@@ -25,6 +25,18 @@ fn drain_quiet(p: &mut DownlinkParser, ms: u32) -> Vec<Downlink> {
     out
 }
 
+fn enc(seq: u8) -> Encoders {
+    Encoders { ticks: [0; 4], seq }
+}
+
+/// [`locked`], then encoder frame 5 and IMU 4 (both emitted, not asserted).
+fn locked_then_encoders_5_and_imu_4() -> (DownlinkParser, Vec<Downlink>) {
+    let mut p = locked();
+    let mut out = feed(&mut p, &enc(5).encode());
+    out.extend(feed(&mut p, &imu(4, 0).encode()));
+    (p, out)
+}
+
 /// A parser locked on IMU frames 1..=3 (all emitted), from a quiet line.
 fn locked() -> DownlinkParser {
     let mut p = DownlinkParser::new();
@@ -548,10 +560,7 @@ fn row11_a_reply_nobody_awaits_ending_in_the_next_headers_first_byte_lost_a_byte
 
 #[test]
 fn row14_hunting_a_frame_whose_tail_is_another_streams_frame_that_lost_a_byte_is_never_taken() {
-    let enc = |seq| Encoders { ticks: [0; 4], seq };
-    let mut p = locked();
-    let mut out = feed(&mut p, &enc(5).encode());
-    out.extend(feed(&mut p, &imu(4, 0).encode()));
+    let (mut p, mut out) = locked_then_encoders_5_and_imu_4();
     // IMU 5 (gyro Y -6, gyro Z 0) with three bytes gained after its header: rejected on its
     // boundary, the parser hunts past it.
     let damaged_imu = [
@@ -588,10 +597,7 @@ fn row14_hunting_a_frame_whose_tail_is_another_streams_frame_that_lost_a_byte_is
 
 #[test]
 fn row14_after_a_dropout_a_whole_frame_with_a_near_count_is_not_judged_by_its_tail() {
-    let enc = |seq| Encoders { ticks: [0; 4], seq };
-    let mut p = locked();
-    let mut out = feed(&mut p, &enc(5).encode());
-    out.extend(feed(&mut p, &imu(4, 0).encode()));
+    let (mut p, mut out) = locked_then_encoders_5_and_imu_4();
     // A dropout: IMU 5's first six bytes, then nothing until IMU 7 (IMU 6 lost whole). IMU 7
     // starts inside the frame cut short (rejected on its boundary), and its accel Y is -5
     // (`FF FB`): its last eleven bytes read as encoder frame 7, continuing encoder frame 5.
@@ -619,7 +625,6 @@ fn row14_after_a_dropout_a_whole_frame_with_a_near_count_is_not_judged_by_its_ta
 
 #[test]
 fn row14_hunting_the_tail_of_a_frame_that_lost_its_first_byte_is_never_taken() {
-    let enc = |seq| Encoders { ticks: [0; 4], seq };
     let mut p = locked();
     let mut out = Vec::new();
     for seq in 4..=6 {
