@@ -1,5 +1,6 @@
-//! Parses a realistic board stream (100 000 frames; `noisy`: with 1e-3 errors per byte; `slices`:
-//! through `frames()` in 64-byte reads instead of `push`) and prints bytes and frames. Run it
+//! Parses a realistic board stream (100 000 frames; `noisy`: with 1e-3 errors per byte; `random`:
+//! as many random bytes instead; `slices`: through `frames()` in 64-byte reads instead of `push`)
+//! and prints bytes and frames. Run it
 //! under `valgrind --tool=callgrind --toggle-collect='*parse_cost::parse*'` for a deterministic
 //! instruction count of the parsing alone (the stream is made outside the measured functions).
 //! Host instructions; Cortex-M counts belong to the MCU issue.
@@ -7,7 +8,7 @@
 use chassis_host_tests::BoardStream;
 use chassis_host_tests::channel::{Noise, transmit};
 use chassis_protocol::DownlinkParser;
-use rand::SeedableRng;
+use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use std::hint::black_box;
 
@@ -35,9 +36,13 @@ fn parse_slices(bytes: &[u8]) -> usize {
 
 fn main() {
     let noisy = std::env::args().any(|a| a == "noisy");
+    let random = std::env::args().any(|a| a == "random");
     let sliced = std::env::args().any(|a| a == "slices");
     let (bytes, _) = BoardStream::new(2026, 2.0).take(100_000);
-    let bytes = if noisy {
+    let bytes = if random {
+        let mut rng = Pcg64Mcg::seed_from_u64(7);
+        (0..bytes.len()).map(|_| rng.random()).collect()
+    } else if noisy {
         transmit(&bytes, &Noise::mixed(1e-3), &mut Pcg64Mcg::seed_from_u64(1)).bytes
     } else {
         bytes

@@ -431,9 +431,7 @@ impl DownlinkParser {
             if self.buf.len() == 0 {
                 let junk = bytes.iter().take_while(|b| !Kind::may_start(**b)).count();
                 if junk > 0 {
-                    for byte in bytes.iter().take(junk) {
-                        self.discard(*byte);
-                    }
+                    self.discard_run(bytes.get(..junk).unwrap_or(&[]));
                     bytes = bytes.get(junk..).unwrap_or(&[]);
                     continue;
                 }
@@ -1116,29 +1114,53 @@ impl DownlinkParser {
     /// one right before the window's first byte now.
     fn discard(&mut self, byte: u8) {
         self.before = self.before << 8 | u32::from(byte);
-        self.before_len = self.before_len.saturating_add(1);
-        self.consumed(1);
+        self.thrown_away(1);
+    }
+
+    /// Counts the bytes of `run` thrown away, in one step: the same as one
+    /// [`discard`](Self::discard) per byte. The last of them is now right before the window's
+    /// first byte.
+    #[inline]
+    fn discard_run(&mut self, run: &[u8]) {
+        let n = run.len();
+        for byte in run.iter().skip(n.saturating_sub(4)) {
+            self.before = self.before << 8 | u32::from(*byte);
+        }
+        self.thrown_away(n);
+    }
+
+    /// The counters, counts and lock for `n` bytes thrown away.
+    #[inline]
+    fn thrown_away(&mut self, n: usize) {
+        self.before_len = self
+            .before_len
+            .saturating_add(u8::try_from(n).unwrap_or(u8::MAX));
+        self.consumed(n);
         self.counts.discarded();
-        self.stats.discarded = self.stats.discarded.wrapping_add(1);
-        if self.lock != Lock::Hunting {
+        self.stats.discarded = self
+            .stats
+            .discarded
+            .wrapping_add(u32::try_from(n).unwrap_or(u32::MAX));
+        if self.lock != Lock::Hunting && n > 0 {
             self.stats.lock_losses = self.stats.lock_losses.wrapping_add(1);
             self.lock = Lock::Hunting;
         }
     }
 
-    /// `n` bytes left the window.
+    /// `n` bytes left the window (the counts are forgotten each time [`FORGET_AFTER`] bytes
+    /// without a frame are reached, as if one byte at a time).
     fn consumed(&mut self, n: usize) {
         self.shadow = self
             .shadow
             .saturating_sub(u8::try_from(n).unwrap_or(u8::MAX));
         self.counts.bytes(n);
-        self.since_frame = self
-            .since_frame
-            .saturating_add(u16::try_from(n).unwrap_or(u16::MAX));
-        if self.since_frame >= FORGET_AFTER {
+        let mut total = usize::from(self.since_frame).saturating_add(n);
+        let forget_after = usize::from(FORGET_AFTER);
+        if total >= forget_after {
             self.counts.forget();
-            self.since_frame = 0;
+            total = total.checked_rem(forget_after).unwrap_or(0);
         }
+        self.since_frame = u16::try_from(total).unwrap_or(0);
     }
 
     /// Consumes an accepted frame: counts, counters, lock.
