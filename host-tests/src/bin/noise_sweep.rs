@@ -5,8 +5,11 @@
 //! cargo run --release -p chassis-host-tests --bin noise-sweep -- [--frames N] [--seed S]
 //! ```
 //!
-//! Prints a Markdown table: recall of untouched frames, false frames per million sent, untouched
-//! frames lost per channel error, latency, and the parser's own counters.
+//! Prints Markdown tables: recall of untouched frames, false frames per million sent, untouched
+//! frames lost per channel error, latency, and the parser's own counters; then every stream model
+//! (payloads, count models, quiet reported or not) with the parser told nothing of the master's
+//! reads, and again with them known (as the driver, or `chassis decode --master`, tells it);
+//! the simulator's stream; and starting to listen mid-stream.
 
 use chassis_host_tests::board::simulator_stream;
 use chassis_host_tests::channel::{Noise, transmit};
