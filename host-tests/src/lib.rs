@@ -13,8 +13,8 @@ pub mod splice;
 pub use board::{BoardStream, CountModel, Gap, Payload, Read, SentFrame, reads_behind};
 pub use channel::{Noise, Received};
 pub use score::{
-    Score, Startup, score_downlink, score_downlink_listening, score_downlink_with_gaps, startup,
-    startup_with_idle,
+    FalseFrame, Score, Startup, score_downlink, score_downlink_listening, score_downlink_traced,
+    score_downlink_with_gaps, startup, startup_with_idle,
 };
 
 /// Cuts `bytes` into consecutive pieces whose lengths are taken from `lengths` in turn (each at

@@ -105,6 +105,29 @@ pub fn score_downlink_listening(
     gaps: &[Gap],
     reads: &[Read],
 ) -> Score {
+    score_downlink_traced(sent, rx, gaps, reads, &mut |_| {})
+}
+
+/// A false frame the parser emitted: the frame, and where its first and last bytes are in the
+/// received stream.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FalseFrame {
+    /// The frame.
+    pub frame: Downlink,
+    /// Offset of its first byte in the received bytes.
+    pub start: usize,
+    /// Offset of its last byte in the received bytes.
+    pub end: usize,
+}
+
+/// [`score_downlink_listening`], handing each false frame to `on_false` as it is judged.
+pub fn score_downlink_traced(
+    sent: &[SentFrame],
+    rx: &Received,
+    gaps: &[Gap],
+    reads: &[Read],
+    on_false: &mut dyn FnMut(FalseFrame),
+) -> Score {
     let by_start: HashMap<usize, usize> =
         sent.iter().enumerate().map(|(i, f)| (f.start, i)).collect();
     let by_last: HashMap<usize, usize> = sent
@@ -162,6 +185,7 @@ pub fn score_downlink_listening(
                     score.damaged += 1;
                 } else {
                     score.false_frames += 1;
+                    on_false(FalseFrame { frame, start, end });
                 }
             }
         }
