@@ -805,13 +805,11 @@ impl DownlinkParser {
         };
         let len = frame.kind().len();
         // The byte `back` bytes before the window's first, if it was seen.
+        let seen = self.before.to_le_bytes();
         let before = |back: usize| {
-            ((1..=4).contains(&back) && back <= usize::from(self.before_len)).then(|| {
-                let shift = back.saturating_sub(1).saturating_mul(8);
-                self.before
-                    .checked_shr(u32::try_from(shift).unwrap_or(u32::MAX))
-                    .unwrap_or(0) as u8
-            })
+            seen.get(back.wrapping_sub(1))
+                .copied()
+                .filter(|_| back <= usize::from(self.before_len))
         };
         let [sync, _] = telemetry::Imu::HEADER;
         Stream::ALL.iter().any(|outer| {
