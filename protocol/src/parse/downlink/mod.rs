@@ -39,7 +39,7 @@
 //! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it); Locked, past a damaged next frame, when the frame after it continues |
 //! | 12 | Hunting | a reply nobody awaits, or the awaited code inside a frame rejected on a boundary | never |
 //! | 13 | Hunting | telemetry, count far | when its own stream's next three frames in the chain move on from it in step (the board restarted its counts) |
-//! | 14 | Hunting | telemetry whose last bytes are a frame of another stream that lost or gained a byte, or, inside a frame rejected on a boundary and with a count not near its own stream's, a whole one; ending on the same count byte, which fits that stream; or telemetry that is the tail of a frame of another stream that lost its first byte | never (a whole inner frame: the scan reaches it next) |
+//! | 14 | Hunting | telemetry whose last bytes are a frame of another stream that lost or gained a byte, or, inside a frame rejected on a boundary and with a count not near its own stream's, a whole one; ending on the same count byte, which fits that stream; telemetry that is the tail of a frame of another stream that lost its first byte; or telemetry starting in a reply's value whose tail, from the reply's end, is a whole frame of another stream (same count byte, which fits it) | never (a whole inner frame: the scan reaches it next) |
 //! | 15 | any | telemetry, count far, its last two bytes a telemetry header (a cut frame running into the next one) | never |
 //!
 //! *A frame of another stream that lost or gained a byte* (row 14): its header inside the
@@ -57,6 +57,13 @@
 //! thrown away right before the candidate (not after an `FF`), where the rest of a frame of that
 //! stream ends on the candidate's count byte, which fits that stream: an encoder frame's header
 //! in an IMU frame's payload (accel Y of -5) whose own `FF` was lost.
+//!
+//! *Starting in a reply's value* (row 14): the two bytes thrown away right before the
+//! candidate are `23` and a reply code, and from where that reply ends (four bytes in) the
+//! candidate's tail is a whole frame of another stream, ending on the candidate's count byte,
+//! which fits that stream: a reply nobody awaits (never taken while hunting) whose value starts
+//! `FF FA`, then a real encoder frame; under one counter shared by all streams, or a time tick,
+//! the encoder frame's count continues the IMU stream too.
 //!
 //! *Inside a frame rejected on a boundary* (rows 9, 12 and 14): a candidate that starts within
 //! the length the rejected frame's header promised, less [`MAX_DROPPED`] bytes it may have lost.
@@ -724,6 +731,7 @@ impl DownlinkParser {
                 && at == 0
                 && (self.shadow > 0 && !self.near(frame) && self.nests_a_frame(frame, &[0])
                     || self.nests_a_frame(frame, &[1, -1])
+                    || self.in_a_replys_value(frame)
                     || self.inside_a_headless_frame(frame)) =>
             {
                 Class::Nested
@@ -792,6 +800,32 @@ impl DownlinkParser {
                         })
                 })
         })
+    }
+
+    /// Whether the telemetry candidate `frame` at the front of the window starts in a reply's
+    /// value (the two bytes thrown away right before it are `23` and a reply code) and its
+    /// tail, from where that reply ends, is a whole frame of another stream whose count (the
+    /// candidate's) fits that stream: the reply and that frame are real, the candidate
+    /// straddles them (a value starting `FF FA`).
+    fn in_a_replys_value(&self, frame: &Downlink) -> bool {
+        let (Kind::Telemetry(outer), Some(seq)) = (frame.kind(), frame.seq()) else {
+            return false;
+        };
+        let [code, hash, ..] = self.before.to_le_bytes();
+        if self.before_len < 2 || Kind::from_header(hash, code) != Some(Kind::Reply) {
+            return false;
+        }
+        let len = frame.kind().len();
+        let off = Kind::Reply.len().saturating_sub(2);
+        let bytes = self.buf.as_slice().get(..len).unwrap_or(&[]);
+        bytes
+            .get(off..off.saturating_add(2))
+            .and_then(telemetry_header)
+            .is_some_and(|inner| {
+                inner != outer
+                    && Kind::Telemetry(inner).len().saturating_add(off) == len
+                    && matches!(self.counts.rel(inner, seq, off), Rel::Continues | Rel::Near)
+            })
     }
 
     /// Whether the telemetry candidate `frame` at the front of the window is the tail of a

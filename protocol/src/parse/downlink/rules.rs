@@ -38,7 +38,9 @@ pub enum Class {
     /// count fits that stream. Bytes that happen to hold a header, then the real frame: both
     /// cannot be real, and a whole inner one, which starts with its own header, is judged on
     /// its own when the scan reaches it. Or telemetry that is the tail of a frame of another
-    /// stream that lost its first byte (its lone second header byte just before).
+    /// stream that lost its first byte (its lone second header byte just before). Or telemetry
+    /// starting in a reply's value whose tail, from the reply's end, is a whole frame of
+    /// another stream (ending on the same count byte, which fits it).
     Nested,
 }
 
@@ -124,7 +126,8 @@ pub const fn need(lock: Lock, class: Class) -> Need {
         (Lock::Hunting, Class::Far) => Need::Chain(Chain::Restart),
         // 14. Hunting, a frame of another stream that lost or gained a byte (or, inside a
         //     frame rejected on a boundary, a whole one) fills the candidate's tail, its count
-        //     fitting; or the candidate is the tail of a frame that lost its first byte: never
+        //     fitting; or the candidate is the tail of a frame that lost its first byte; or it
+        //     starts in a reply's value and a whole frame fills it from the reply's end: never
         //     (a whole inner frame: the scan reaches it next). Only ever found while hunting.
         (_, Class::Nested) => Need::Never,
         // 15. A far count that is a header's second byte (the frame ends with a header): never.

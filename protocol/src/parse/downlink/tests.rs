@@ -231,7 +231,7 @@ fn a_count_that_moved_on_is_followed() {
     let mut enc = 0u8;
     for seq in (1..=8u8).chain(21..=40) {
         stream.extend_from_slice(&imu(seq, 3).encode());
-        if seq % 4 == 0 {
+        if seq.is_multiple_of(4) {
             enc = enc.wrapping_add(1);
             let ticks = [1, 2, 3, i16::from(enc)];
             stream.extend_from_slice(&Encoders { ticks, seq: enc }.encode());
@@ -650,5 +650,37 @@ fn row14_hunting_the_tail_of_a_frame_that_lost_its_first_byte_is_never_taken() {
         want.extend([Downlink::from(enc(seq)), imu(seq, 0).into()]);
     }
     want.extend([Downlink::from(imu(8, 0)), enc(8).into(), imu(9, 0).into()]);
+    assert_eq!(out, want);
+}
+
+#[test]
+fn row14_hunting_a_frame_in_a_replys_value_whose_tail_is_the_next_frame_is_never_taken() {
+    // One counter for all streams: IMU 1..=3 (locked), then encoders every fourth count.
+    let mut p = locked();
+    let mut out = Vec::new();
+    let mut want: Vec<Downlink> = Vec::new();
+    let frame = |seq: u8| -> Downlink {
+        if seq.is_multiple_of(4) {
+            enc(seq).into()
+        } else {
+            imu(seq, 0).into()
+        }
+    };
+    for seq in 4..=14 {
+        out.extend(feed(&mut p, &frame(seq).encode()));
+        want.push(frame(seq));
+    }
+    // IMU 15 loses its count byte (rejected on its boundary: the parser hunts), then a reply
+    // nobody awaits whose value starts `FF FA`: from there, the reply's last four bytes and
+    // encoder frame 16 read as an IMU frame with count 16, one step on from IMU 14 (+2 after
+    // an encoder frame), and IMU 17 would continue it.
+    let imu15 = imu(15, 0).encode();
+    out.extend(feed(&mut p, &imu15[..imu15.len() - 1]));
+    out.extend(feed(&mut p, &[0x23, 0x0B, 0xFF, 0xFA, 0x04, 0xB0]));
+    for seq in 16..=21 {
+        out.extend(feed(&mut p, &frame(seq).encode()));
+        want.push(frame(seq));
+    }
+    out.extend(drain_quiet(&mut p, 1));
     assert_eq!(out, want);
 }
