@@ -13,8 +13,9 @@
 //! 2. **The count byte**, against what the line has taught ([`counts`]): the vendor does not
 //!    say what it counts (A10), so the parser learns each stream's steps from the line (per
 //!    stream +1 or +k, one counter shared by all streams, a time tick: all work).
-//! 3. **Where it starts**: right after a frame taken on good evidence (*Locked*), right after a
-//!    quiet line (*Tentative*), or anywhere (*Hunting*).
+//! 3. **Where it starts**: right after a frame taken on good evidence (*Locked*; *Resynced*
+//!    when that frame was found while hunting), right after a quiet line (*Tentative*), or
+//!    anywhere (*Hunting*). Rows that say Locked hold for Resynced too, but row 5.
 //! 4. **What follows**: a header right after it, or a **chain**: the frames right after it,
 //!    back to back, reaching one whose count continues its stream (counting the candidate).
 //! 5. **Whether a reply is awaited**: the master knows when it asked
@@ -30,7 +31,7 @@
 //! | 2 | Locked or Tentative | the awaited reply, no telemetry header inside its value | on its last byte |
 //! | 3 | Locked or Tentative | the awaited reply that could hide a cut frame | with a header (or quiet line) after it |
 //! | 4 | Locked | telemetry, count near (frames lost) or the stream's first | with a header (or quiet line) after it |
-//! | 5 | Locked | telemetry, count far | when the chain after it vouches, far counts in it re-based |
+//! | 5 | Locked (not Resynced) | telemetry, count far | when the chain after it vouches, far counts in it re-based |
 //! | 6 | Tentative | telemetry, count near (the board paused) | with a header (or quiet line) after it |
 //! | 7 | Tentative | telemetry, the stream's first or a far count | when the chain vouches (far counts in it re-based), or it fills the burst up to the next quiet line |
 //! | 8 | Hunting | telemetry, count continues or near (and fits no other stream) | when the chain vouches |
@@ -38,7 +39,7 @@
 //! | 10 | Hunting | the awaited reply, not inside a frame rejected on a boundary | when the chain (or a quiet line) vouches, and the chain holds no other reply with its code |
 //! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it); Locked, past a damaged next frame, when the frame after it continues |
 //! | 12 | Hunting | a reply nobody awaits, or the awaited code inside a frame rejected on a boundary | never |
-//! | 13 | Hunting | telemetry, count far | when its own stream's next three frames in the chain move on from it in step (the board restarted its counts) |
+//! | 13 | Hunting or Resynced | telemetry, count far | when its own stream's next three frames in the chain move on from it in step (the board restarted its counts) |
 //! | 14 | Hunting | telemetry whose last bytes are a frame of another stream that lost or gained a byte, or, inside a frame rejected on a boundary and with a count not near its own stream's, a whole one; ending on the same count byte, which fits that stream; telemetry that is the tail of a frame of another stream that lost its first byte; or telemetry starting in a reply's value whose tail, from the reply's end, is a whole frame of another stream (same count byte, which fits it) | never (a whole inner frame: the scan reaches it next) |
 //! | 15 | any | telemetry, count far, its last two bytes a telemetry header (a cut frame running into the next one) | never |
 //!
@@ -57,6 +58,12 @@
 //! thrown away right before the candidate (not after an `FF`), where the rest of a frame of that
 //! stream ends on the candidate's count byte, which fits that stream: an encoder frame's header
 //! in an IMU frame's payload (accel Y of -5) whose own `FF` was lost.
+//!
+//! *Resynced* (rows 5 and 13): right after a frame found while hunting, the boundary is only as
+//! sure as that frame. Lookalikes in adversarial payloads come back to back (each ends where
+//! the next starts); once one is taken, the next has a boundary of sorts, and a far count
+//! there re-based by a chain of more lookalikes let a run of false frames through after a
+//! dropout. A far count there needs what it needs while hunting.
 //!
 //! *Starting in a reply's value* (row 14): the two bytes thrown away right before the
 //! candidate are `23` and a reply code, and from where that reply ends (four bytes in) the
@@ -135,7 +142,7 @@ use super::stats::DownlinkStats;
 use crate::command::Register;
 use crate::telemetry::{self, Downlink, Kind, Stream};
 use counts::{Counts, Rel};
-use rules::{Chain, Class, Need};
+use rules::{Chain, Class, Need, Start};
 
 /// Bytes the parser keeps at most: enough for a candidate and the chain after it; at start-up
 /// three IMU frames with an encoder or battery frame and a reply among them.
@@ -313,6 +320,8 @@ pub struct DownlinkParser {
     missing: u8,
     /// Start positions still inside the frame last rejected on a boundary (row 14).
     shadow: u8,
+    /// The frame before the window was found while hunting (see [`Start::Resynced`]).
+    resynced: bool,
     /// The bytes thrown away right before the window's first byte, newest in the low byte
     /// (row 14: a frame that lost its first byte), and how many of them there are.
     before: u32,
@@ -345,6 +354,7 @@ impl DownlinkParser {
             since_frame: 0,
             missing: 0,
             shadow: 0,
+            resynced: false,
             before: 0,
             before_len: 0,
             stats: DownlinkStats::new(),
@@ -522,8 +532,8 @@ impl DownlinkParser {
         // (What row 11 needs, whatever kind of boundary.)
         const _: () = assert!(matches!(
             (
-                rules::need(Lock::Locked, Class::Unexpected),
-                rules::need(Lock::Tentative, Class::Unexpected),
+                rules::need(Start::Locked, Class::Unexpected),
+                rules::need(Start::Tentative, Class::Unexpected),
             ),
             (Need::Chain(Chain::Exact), Need::Chain(Chain::Exact))
         ));
@@ -553,8 +563,8 @@ impl DownlinkParser {
         // (Row 1 holds on a boundary whatever kind of boundary it is.)
         const _: () = assert!(matches!(
             (
-                rules::need(Lock::Locked, Class::Continues),
-                rules::need(Lock::Tentative, Class::Continues),
+                rules::need(Start::Locked, Class::Continues),
+                rules::need(Start::Tentative, Class::Continues),
             ),
             (Need::Now, Need::Now)
         ));
@@ -876,6 +886,14 @@ impl DownlinkParser {
         })
     }
 
+    /// Where the candidate at the front of the window starts, as the rules see it.
+    fn start(&self) -> Start {
+        match self.lock {
+            Lock::Locked if self.resynced => Start::Resynced,
+            lock => Start::from(lock),
+        }
+    }
+
     /// Judges the candidate at the front of the window. `quiet`: the line has gone quiet, so
     /// no more bytes are coming for now.
     fn judge(&self, quiet: bool) -> Verdict {
@@ -901,7 +919,7 @@ impl DownlinkParser {
             return Verdict::Reject;
         };
         let class = self.class(&frame, 0);
-        let taken = match rules::need(self.lock, class) {
+        let taken = match rules::need(self.start(), class) {
             Need::Now => Ok(true),
             Need::Never => Ok(false),
             Need::Follow => followed(buf, len, quiet).ok_or(1),
@@ -1252,6 +1270,7 @@ impl DownlinkParser {
         self.shadow = 0;
         self.before_len = 0;
         self.stats.count_frame(kind);
+        self.resynced = self.lock == Lock::Hunting;
         if self.lock == Lock::Hunting {
             self.stats.resyncs = self.stats.resyncs.wrapping_add(1);
         }

@@ -3,6 +3,32 @@
 
 use super::Lock;
 
+/// Where the candidate starts, as the rules tell places apart: the parser's [`Lock`], with
+/// Locked split by how the frame before the candidate was found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Start {
+    /// Alignment unknown: anywhere.
+    Hunting,
+    /// Right after a quiet line.
+    Tentative,
+    /// Right after a frame taken on a boundary.
+    Locked,
+    /// Right after a frame found while hunting: a boundary only as sure as that frame, which
+    /// may have been a false one among lookalikes (back to back in a payload, each would end
+    /// where the next starts).
+    Resynced,
+}
+
+impl From<Lock> for Start {
+    fn from(lock: Lock) -> Self {
+        match lock {
+            Lock::Hunting => Start::Hunting,
+            Lock::Tentative => Start::Tentative,
+            Lock::Locked => Start::Locked,
+        }
+    }
+}
+
 /// What a whole candidate is, before anything after it is looked at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Class {
@@ -85,45 +111,56 @@ pub enum Need {
     Never,
 }
 
-/// The rules. `lock`: how sure the parser is that the candidate starts where a frame starts
-/// (Locked: right after a frame taken on good evidence; Tentative: right after a quiet line;
-/// Hunting: anywhere).
-pub const fn need(lock: Lock, class: Class) -> Need {
-    match (lock, class) {
+/// The rules. `start`: how sure the parser is that the candidate starts where a frame starts
+/// (Locked: right after a frame taken on good evidence, Resynced if that frame was found while
+/// hunting; Tentative: right after a quiet line; Hunting: anywhere).
+pub const fn need(start: Start, class: Class) -> Need {
+    match (start, class) {
         // 1. Aligned, the count continues: the fast path.
-        (Lock::Locked | Lock::Tentative, Class::Continues | Class::Ambiguous) => Need::Now,
+        (
+            Start::Locked | Start::Resynced | Start::Tentative,
+            Class::Continues | Class::Ambiguous,
+        ) => Need::Now,
         // 2. Aligned, the awaited reply, nothing in its value that could be a cut frame.
-        (Lock::Locked | Lock::Tentative, Class::Expected { clean: true }) => Need::Now,
+        (Start::Locked | Start::Resynced | Start::Tentative, Class::Expected { clean: true }) => {
+            Need::Now
+        }
         // 3. Aligned, the awaited reply that could hide a cut.
-        (Lock::Locked | Lock::Tentative, Class::Expected { clean: false }) => Need::Follow,
+        (Start::Locked | Start::Resynced | Start::Tentative, Class::Expected { clean: false }) => {
+            Need::Follow
+        }
         // 4. On a certain boundary, frames lost or a stream's first frame: a header after it.
-        (Lock::Locked, Class::Near | Class::First) => Need::Follow,
-        // 5. On a certain boundary, a far count: the next frames must vouch (re-basing).
-        (Lock::Locked, Class::Far) => Need::Chain(Chain::Rebase),
+        (Start::Locked | Start::Resynced, Class::Near | Class::First) => Need::Follow,
+        // 5. On a certain boundary (not right after a frame found while hunting), a far
+        //    count: the next frames must vouch (re-basing).
+        (Start::Locked, Class::Far) => Need::Chain(Chain::Rebase),
         // 6. After a quiet line, frames lost (the board paused): a header after it.
-        (Lock::Tentative, Class::Near) => Need::Follow,
+        (Start::Tentative, Class::Near) => Need::Follow,
         // 7. Right after a quiet line (a boundary, but nothing proved yet), nothing to compare
         //    the count with, or a far one: the chain must vouch, re-basing far counts.
-        (Lock::Tentative, Class::First | Class::Far) => Need::Chain(Chain::Rebase),
+        (Start::Tentative, Class::First | Class::Far) => Need::Chain(Chain::Rebase),
         // 8. Hunting, a plausible count: the next frames must vouch.
-        (Lock::Hunting, Class::Continues | Class::Near) => Need::Chain(Chain::Verify),
+        (Start::Hunting, Class::Continues | Class::Near) => Need::Chain(Chain::Verify),
         // 9. Hunting, a stream's first frame, a count another stream's could explain, or any
         //    count inside a frame rejected on a boundary: its own stream's next frame must
         //    continue it.
-        (Lock::Hunting, Class::First | Class::Ambiguous) => Need::Chain(Chain::Own),
+        (Start::Hunting, Class::First | Class::Ambiguous) => Need::Chain(Chain::Own),
         // 10. Hunting, the awaited reply (not inside a frame rejected on a boundary): the next
         //     frames (or the quiet line) must vouch, and hold no other reply with its code.
-        (Lock::Hunting, Class::Expected { .. }) => Need::Chain(Chain::Verify),
+        (Start::Hunting, Class::Expected { .. }) => Need::Chain(Chain::Verify),
         // 11. A reply nobody waits for, on a boundary: the very next frame must continue its
         //     count exactly (Locked: or, past a damaged next frame, the frame after it).
-        (Lock::Locked | Lock::Tentative, Class::Unexpected) => Need::Chain(Chain::Exact),
+        (Start::Locked | Start::Resynced | Start::Tentative, Class::Unexpected) => {
+            Need::Chain(Chain::Exact)
+        }
         // 12. A reply nobody waits for (or the awaited code inside a frame rejected on a
         //     boundary), hunting: never (the tail of a damaged frame, `23` and a code in its
         //     payload, ends right where the next real frame starts).
-        (Lock::Hunting, Class::Unexpected) => Need::Never,
-        // 13. Hunting, a far count: its own stream's next three frames must move on from it in
-        //     step (a board that restarted its counts).
-        (Lock::Hunting, Class::Far) => Need::Chain(Chain::Restart),
+        (Start::Hunting, Class::Unexpected) => Need::Never,
+        // 13. Hunting, or right after a frame found while hunting, a far count: its own
+        //     stream's next three frames must move on from it in step (a board that restarted
+        //     its counts).
+        (Start::Hunting | Start::Resynced, Class::Far) => Need::Chain(Chain::Restart),
         // 14. Hunting, a frame of another stream that lost or gained a byte (or, inside a
         //     frame rejected on a boundary, a whole one) fills the candidate's tail, its count
         //     fitting; or the candidate is the tail of a frame that lost its first byte; or it
@@ -138,11 +175,11 @@ pub const fn need(lock: Lock, class: Class) -> Need {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use Lock::{Hunting, Locked, Tentative};
+    use Start::{Hunting, Locked, Resynced, Tentative};
 
     #[test]
     fn row1_aligned_and_continuing_is_taken_at_once() {
-        for lock in [Locked, Tentative] {
+        for lock in [Locked, Resynced, Tentative] {
             assert_eq!(need(lock, Class::Continues), Need::Now);
             assert_eq!(need(lock, Class::Ambiguous), Need::Now);
         }
@@ -165,8 +202,10 @@ mod tests {
 
     #[test]
     fn row4_lost_frames_or_a_first_frame_on_a_boundary_wait_for_a_header() {
-        assert_eq!(need(Locked, Class::Near), Need::Follow);
-        assert_eq!(need(Locked, Class::First), Need::Follow);
+        for lock in [Locked, Resynced] {
+            assert_eq!(need(lock, Class::Near), Need::Follow);
+            assert_eq!(need(lock, Class::First), Need::Follow);
+        }
     }
 
     #[test]
@@ -208,7 +247,7 @@ mod tests {
 
     #[test]
     fn row11_a_reply_nobody_waits_for_on_a_boundary_needs_an_exact_count_after_it() {
-        for lock in [Tentative, Locked] {
+        for lock in [Tentative, Locked, Resynced] {
             assert_eq!(need(lock, Class::Unexpected), Need::Chain(Chain::Exact));
         }
     }
@@ -225,13 +264,14 @@ mod tests {
 
     #[test]
     fn row15_a_far_count_that_is_the_next_headers_second_byte_is_never_taken() {
-        for lock in [Hunting, Tentative, Locked] {
+        for lock in [Hunting, Tentative, Locked, Resynced] {
             assert_eq!(need(lock, Class::Cut), Need::Never);
         }
     }
 
     #[test]
-    fn row13_hunting_a_far_count_needs_its_stream_moving_in_step() {
+    fn row13_hunting_or_right_after_a_frame_found_hunting_a_far_count_needs_its_stream_in_step() {
         assert_eq!(need(Hunting, Class::Far), Need::Chain(Chain::Restart));
+        assert_eq!(need(Resynced, Class::Far), Need::Chain(Chain::Restart));
     }
 }

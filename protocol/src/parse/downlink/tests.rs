@@ -684,3 +684,58 @@ fn row14_hunting_a_frame_in_a_replys_value_whose_tail_is_the_next_frame_is_never
     out.extend(drain_quiet(&mut p, 1));
     assert_eq!(out, want);
 }
+
+/// Rows 5 and 13, Resynced. Bytes received in the sweep (seed 4242, adversarial payloads, one
+/// counter shared by all streams, 32-byte dropouts): IMU 244 whole; IMU 245 cut after 13 bytes
+/// by a dropout that takes IMU 246, encoder frame 247 and IMU 248's first four bytes; then IMU
+/// 248's rest, IMU 249 to 255 and encoder frame 252, whose payloads are full of `FF FB`. An
+/// encoder lookalike in IMU 245's tail is found while hunting (near count 252). Right after
+/// it, lookalikes back to back: before, the first with a far count (6) was taken on its
+/// "boundary", re-based by the next ones' counts, and two more came out (21, 250).
+#[test]
+fn row13_right_after_a_frame_found_hunting_a_far_count_needs_its_stream_in_step() {
+    let received: [u8; 140] = [
+        0xFF, 0xFA, 0x00, 0x07, 0x23, 0x06, 0x3F, 0xFA, 0xFF, 0xFB, 0xFF, 0xFA, 0x23, 0x08, 0xF4,
+        0xFF, 0xFA, 0xFF, 0xFC, 0x00, 0x27, 0x3F, 0xF4, 0x00, 0x06, 0xFF, 0xFB, 0xFF, 0xFF, 0xFB,
+        0x3F, 0xFB, 0xFF, 0xFC, 0xFF, 0xFC, 0xFF, 0xFB, 0xF8, 0xFF, 0xFA, 0xFF, 0xFA, 0x23, 0x20,
+        0x63, 0x06, 0xFF, 0xFB, 0xFF, 0xFA, 0x00, 0x00, 0xF9, 0xFF, 0xFA, 0x00, 0x15, 0xFF, 0xFB,
+        0x3F, 0xE3, 0x00, 0x08, 0xFF, 0xFC, 0x00, 0x02, 0xFA, 0xFF, 0xFA, 0xFF, 0xDA, 0x23, 0x09,
+        0x3F, 0xFC, 0xFF, 0xFB, 0x23, 0x01, 0x00, 0x00, 0xFB, 0xFF, 0xFB, 0xC0, 0xB9, 0xB8, 0xF2,
+        0xBB, 0x76, 0xBA, 0x2D, 0xFC, 0xFF, 0xFA, 0x00, 0x0A, 0xFF, 0xFA, 0x3F, 0xFC, 0x00, 0x03,
+        0x00, 0x02, 0x23, 0x0B, 0xFD, 0xFF, 0xFA, 0xFF, 0xFC, 0x23, 0x07, 0x3F, 0xE2, 0xFF, 0xFB,
+        0x23, 0x0C, 0x00, 0x00, 0xFE, 0xFF, 0xFA, 0x00, 0x1B, 0x23, 0x07, 0x3F, 0xFB, 0x00, 0x08,
+        0x23, 0x0C, 0x23, 0x0C, 0xFF,
+    ];
+    // One counter: an encoder frame every fifth count (242, 247, 252, ...), IMU frames between.
+    let frame = |count: u16| -> Downlink {
+        let seq = (count % 256) as u8;
+        if (count + 3).is_multiple_of(5) {
+            enc(seq).into()
+        } else {
+            imu(seq, 0).into()
+        }
+    };
+    let mut p = DownlinkParser::new();
+    assert_eq!(p.quiet(1), None);
+    let mut out = Vec::new();
+    for count in 202..=243 {
+        out.extend(feed(&mut p, &frame(count).encode()));
+    }
+    out.extend(feed(&mut p, &received));
+    let mut after = Vec::new();
+    for count in 256..=275 {
+        after.extend(feed(&mut p, &frame(count).encode()));
+    }
+    after.extend(drain_quiet(&mut p, 1));
+    out.extend(after.iter().cloned());
+    // (The clean frames written here have ticks of 0.)
+    let lookalikes: Vec<&Downlink> = out
+        .iter()
+        .filter(|f| matches!(f, Downlink::Encoders(e) if e.ticks != [0; 4] && [6, 21, 250].contains(&e.seq)))
+        .collect();
+    assert!(lookalikes.is_empty(), "{lookalikes:?}");
+    // The clean frames after the damage all come out.
+    for count in 258..=275 {
+        assert!(after.contains(&frame(count)), "{count} lost: {after:?}");
+    }
+}
