@@ -117,6 +117,16 @@ impl Counts {
         self.known != 0
     }
 
+    /// Whether a frame of `stream` starting `bytes` after the start of another frame of its own
+    /// comes sooner than the board's rates allow ([`BYTES_PER_FRAME`]) on a line that carries
+    /// IMU frames: both cannot be real. The IMU frames space the others (the encoders' next
+    /// frame comes after four of them, the battery's a second later), while lookalikes in a
+    /// payload come back to back. (A line of one stream only may carry it back to back.)
+    pub fn too_soon(&self, stream: Stream, bytes: usize) -> bool {
+        let fewest = BYTES_PER_FRAME.get(stream.index()).copied().unwrap_or(0);
+        self.knows(Stream::Imu) && bytes < usize::from(fewest)
+    }
+
     /// Whether `stream` has a count.
     pub const fn knows(&self, stream: Stream) -> bool {
         self.known & (1 << stream.index()) != 0

@@ -95,8 +95,11 @@
 //! back, reach one whose count continues (or is near) its stream's count, counting the
 //! candidate itself and the chain's frames before it; frames of streams with no count yet pass
 //! it on, replies too; a far count ends it (fails), except on a certain boundary (row 5) where
-//! it re-bases. A candidate whose count continues exactly may have up to two junk bytes before
-//! its chain. A quiet line right after a candidate whose own count continues or is near, or an
+//! it re-bases. A frame of the candidate's own stream sooner after it than the board's rates
+//! allow on a line that carries IMU frames ([`Counts::too_soon`]: an encoder frame within 60
+//! bytes, a battery frame within 1 500) fails it: both cannot be real (battery lookalikes back to back in a payload, their
+//! counts a learnt step apart by chance). A candidate whose count continues exactly may have
+//! up to two junk bytes before its chain. A quiet line right after a candidate whose own count continues or is near, or an
 //! awaited reply, vouches for it; a quiet line never vouches for a stream's first frame (any
 //! payload can hold a header that ends where the line goes quiet). The chain is looked for
 //! within the window; a window full before it decides is a no.
@@ -1063,6 +1066,9 @@ impl DownlinkParser {
                 continue;
             }
             if let (Kind::Telemetry(stream), Some(seq)) = (next.kind(), next.seq()) {
+                if own == Some(stream) && counts.too_soon(stream, at) {
+                    return Ok(false);
+                }
                 let own_only = matches!(chain, Chain::Own | Chain::Restart);
                 let mut vouches = !own_only || own == Some(stream);
                 let in_step = chain == Chain::Restart || !counts.has_steps(stream);

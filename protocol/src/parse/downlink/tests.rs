@@ -655,29 +655,30 @@ fn row14_hunting_the_tail_of_a_frame_that_lost_its_first_byte_is_never_taken() {
 
 #[test]
 fn row14_hunting_a_frame_in_a_replys_value_whose_tail_is_the_next_frame_is_never_taken() {
-    // One counter for all streams: IMU 1..=3 (locked), then encoders every fourth count.
+    // One counter for all streams: IMU 1..=3 (locked), then an encoder frame every fifth count
+    // (four IMU frames between, as at the board's rates).
     let mut p = locked();
     let mut out = Vec::new();
     let mut want: Vec<Downlink> = Vec::new();
     let frame = |seq: u8| -> Downlink {
-        if seq.is_multiple_of(4) {
+        if seq.is_multiple_of(5) {
             enc(seq).into()
         } else {
             imu(seq, 0).into()
         }
     };
-    for seq in 4..=14 {
+    for seq in 4..=18 {
         out.extend(feed(&mut p, &frame(seq).encode()));
         want.push(frame(seq));
     }
-    // IMU 15 loses its count byte (rejected on its boundary: the parser hunts), then a reply
+    // IMU 19 loses its count byte (rejected on its boundary: the parser hunts), then a reply
     // nobody awaits whose value starts `FF FA`: from there, the reply's last four bytes and
-    // encoder frame 16 read as an IMU frame with count 16, one step on from IMU 14 (+2 after
-    // an encoder frame), and IMU 17 would continue it.
-    let imu15 = imu(15, 0).encode();
-    out.extend(feed(&mut p, &imu15[..imu15.len() - 1]));
+    // encoder frame 20 read as an IMU frame with count 20, one step on from IMU 18 (+2 after
+    // an encoder frame), and IMU 21 would continue it.
+    let imu19 = imu(19, 0).encode();
+    out.extend(feed(&mut p, &imu19[..imu19.len() - 1]));
     out.extend(feed(&mut p, &[0x23, 0x0B, 0xFF, 0xFA, 0x04, 0xB0]));
-    for seq in 16..=21 {
+    for seq in 20..=26 {
         out.extend(feed(&mut p, &frame(seq).encode()));
         want.push(frame(seq));
     }
@@ -736,6 +737,69 @@ fn row13_right_after_a_frame_found_hunting_a_far_count_needs_its_stream_in_step(
     assert!(lookalikes.is_empty(), "{lookalikes:?}");
     // The clean frames after the damage all come out.
     for count in 258..=275 {
+        assert!(after.contains(&frame(count)), "{count} lost: {after:?}");
+    }
+}
+
+/// The chain: a frame of the candidate's own stream sooner after it than the board's rates
+/// allow does not vouch. Bytes received in the sweep (seed 31337, adversarial payloads, one
+/// counter shared by all streams, mixed errors): IMU 120, then IMU 121 with a byte inserted
+/// (rejected on its boundary), whose payload holds two battery lookalikes back to back, counts
+/// 251 and 121: 126 apart, the battery's step under that counter (three battery frames, 126
+/// counts apart, came before). Before, the second vouched for the first and both came out.
+#[test]
+fn chain_a_frame_of_the_candidates_stream_sooner_than_its_rate_does_not_vouch() {
+    let received: [u8; 79] = [
+        0xFF, 0xFA, 0xFF, 0xFB, 0xFF, 0xF1, 0x3F, 0xFB, 0x23, 0x20, 0x00, 0x01, 0xFF, 0xFB, 0x78,
+        0xFF, 0xFA, 0xFF, 0xFC, 0xFF, 0x39, 0xFA, 0x3F, 0xFB, 0xFF, 0xFC, 0x23, 0x08, 0x23, 0x0C,
+        0x79, 0xFF, 0xFB, 0xAC, 0xC1, 0x9F, 0x07, 0xB5, 0x41, 0xA1, 0x0B, 0x7A, 0xFF, 0xFA, 0xFF,
+        0xFC, 0x23, 0x0C, 0x3F, 0xFB, 0x23, 0x0A, 0xFF, 0xFB, 0x00, 0x02, 0x7B, 0xFF, 0xFA, 0x00,
+        0x0B, 0xFF, 0xF9, 0x40, 0x1C, 0x23, 0x08, 0x00, 0x03, 0x00, 0x04, 0x7C, 0xFF, 0xFC, 0x02,
+        0xCE, 0x00, 0x00, 0x7D,
+    ];
+    // One counter (here from 3, wrapping at 256): battery frames at counts 3, 129 and 255, an
+    // encoder frame at every count ending in 2 or 7, IMU frames between.
+    let frame = |count: u16| -> Downlink {
+        let seq = (count % 256) as u8;
+        if [3, 129, 255].contains(&count) {
+            Battery {
+                centivolts: 1_200,
+                percent: 80,
+                seq,
+            }
+            .into()
+        } else if count % 5 == 2 {
+            enc(seq).into()
+        } else {
+            imu(seq, 0).into()
+        }
+    };
+    let mut p = DownlinkParser::new();
+    assert_eq!(p.quiet(1), None);
+    let mut out = Vec::new();
+    for count in 3..256 + 120 {
+        out.extend(feed(&mut p, &frame(count).encode()));
+    }
+    out.extend(feed(&mut p, &received));
+    let mut after = Vec::new();
+    for count in 256 + 126..256 + 150 {
+        after.extend(feed(&mut p, &frame(count).encode()));
+    }
+    after.extend(drain_quiet(&mut p, 1));
+    out.extend(after.iter().cloned());
+    let lookalikes: Vec<&Downlink> = out
+        .iter()
+        .filter(|f| matches!(f, Downlink::Battery(b) if [251, 121].contains(&b.seq)))
+        .collect();
+    assert!(lookalikes.is_empty(), "{lookalikes:?}");
+    // The battery frame in the received bytes comes out, and every clean frame after them.
+    let battery = Battery {
+        centivolts: 718,
+        percent: 0,
+        seq: 125,
+    };
+    assert!(out.contains(&battery.into()), "{out:?}");
+    for count in 256 + 127..256 + 150 {
         assert!(after.contains(&frame(count)), "{count} lost: {after:?}");
     }
 }
