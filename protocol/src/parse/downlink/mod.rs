@@ -34,7 +34,7 @@
 //! | 5 | Locked (not Resynced) | telemetry, count far | when the chain after it vouches, far counts in it re-based |
 //! | 6 | Tentative | telemetry, count near (the board paused) | with a header (or quiet line) after it |
 //! | 7 | Tentative | telemetry, the stream's first or a far count | when the chain vouches (far counts in it re-based), or it fills the burst up to the next quiet line |
-//! | 8 | Hunting | telemetry, count continues or near (and fits no other stream) | when the chain vouches |
+//! | 8 | Hunting | telemetry, count continues or near (and fits no other stream) | when the chain vouches (or, the count continuing exactly, the quiet line right after it) |
 //! | 9 | Hunting | telemetry, the stream's first, a count another stream's could explain, or any count inside a frame rejected on a boundary | when its own stream's next frame in the chain continues it |
 //! | 10 | Hunting | the awaited reply, not inside a frame rejected on a boundary | when the chain (or a quiet line) vouches, and the chain holds no other reply with its code |
 //! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it); Locked, past a damaged next frame, when the frame after it continues |
@@ -97,12 +97,16 @@
 //! it on, replies too; a far count ends it (fails), except on a certain boundary (row 5) where
 //! it re-bases. A frame of the candidate's own stream sooner after it than the board's rates
 //! allow on a line that carries IMU frames ([`Counts::too_soon`]: an encoder frame within 60
-//! bytes, a battery frame within 1 500) fails it: both cannot be real (battery lookalikes back to back in a payload, their
-//! counts a learnt step apart by chance). A candidate whose count continues exactly may have
-//! up to two junk bytes before its chain. A quiet line right after a candidate whose own count continues or is near, or an
-//! awaited reply, vouches for it; a quiet line never vouches for a stream's first frame (any
-//! payload can hold a header that ends where the line goes quiet). The chain is looked for
-//! within the window; a window full before it decides is a no.
+//! bytes, a battery frame within 1 500) fails it: both cannot be real (battery lookalikes back
+//! to back in a payload, their counts a learnt step apart by chance). A candidate whose count
+//! continues exactly may have up to two junk bytes before its chain. A quiet line right after
+//! the candidate vouches for it after a quiet line (Tentative), for the awaited reply, and,
+//! while hunting, for telemetry whose count continues exactly and fits no other stream,
+//! outside a frame rejected on a boundary (the frame after a damaged one in the same burst);
+//! never for a near count found while hunting or one another stream's could explain (a false
+//! frame in a damaged frame's tail ends where the line goes quiet, on that frame's count
+//! byte), nor for a stream's first frame (any payload can hold a header that ends there). The
+//! chain is looked for within the window; a window full before it decides is a no.
 //!
 //! At start-up nothing is known: a stream's first frame found while hunting then needs three
 //! more frames of its stream in the chain, equally spaced by 1 to 4 counts
@@ -963,10 +967,13 @@ impl DownlinkParser {
             Chain::Own | Chain::Restart => false,
             // A far count on a boundary that fills the line up to the quiet.
             Chain::Rebase => self.lock != Lock::Hunting,
-            // Hunting, a quiet line vouches only for the awaited reply: a false frame in a
-            // damaged frame's tail ends exactly where the line goes quiet.
+            // Hunting, a quiet line vouches only for the awaited reply and a count that
+            // continues exactly and fits no other stream, outside a frame rejected on a
+            // boundary: a false frame in a damaged frame's tail ends exactly where the line goes
+            // quiet, on that frame's count byte.
             Chain::Verify => {
-                self.lock == Lock::Tentative || matches!(class, Class::Expected { .. })
+                self.lock == Lock::Tentative
+                    || matches!(class, Class::Expected { .. } | Class::Continues)
             }
         };
         let mut pos = len;

@@ -75,8 +75,9 @@ pub enum Class {
 pub enum Chain {
     /// The frames right after it, adjacent, reach one whose count continues or is near its
     /// stream's (counting the candidate and the frames before it in the chain); frames of
-    /// streams with no count are passed over. A quiet line right after a candidate whose own
-    /// count continues or is near (or an expected reply) also vouches.
+    /// streams with no count are passed over. A quiet line right after the candidate also
+    /// vouches after a quiet line (Tentative), for an expected reply, and, hunting, for a
+    /// count that continues exactly ([`Class::Continues`]).
     Verify,
     /// Only the next frame vouches (a stream's first frame is passed over, a reply is not), and
     /// only if its count continues exactly, or, on a certain boundary (Locked), is near; a quiet
@@ -139,7 +140,8 @@ pub const fn need(start: Start, class: Class) -> Need {
         // 7. Right after a quiet line (a boundary, but nothing proved yet), nothing to compare
         //    the count with, or a far one: the chain must vouch, re-basing far counts.
         (Start::Tentative, Class::First | Class::Far) => Need::Chain(Chain::Rebase),
-        // 8. Hunting, a plausible count: the next frames must vouch.
+        // 8. Hunting, a plausible count: the next frames must vouch (a count that continues
+        //    exactly: or the quiet line right after it).
         (Start::Hunting, Class::Continues | Class::Near) => Need::Chain(Chain::Verify),
         // 9. Hunting, a stream's first frame, a count another stream's could explain, or any
         //    count inside a frame rejected on a boundary: its own stream's next frame must
