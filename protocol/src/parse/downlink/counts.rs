@@ -12,9 +12,12 @@
 //! [`FIRST_STEP_MAX`] as continuing.
 //!
 //! **Steps are learnt only from a line that lost nothing** since the stream's last frame (no
-//! byte thrown away): after a loss, a count may have moved on by frames lost, and a step learnt
-//! from that would let false frames' counts through for good. On such a line a near count
-//! cannot be frames lost: seen twice, its distance is a step ([`Counts::take_near`]).
+//! byte thrown away, no quiet stretch as long as the stream's period): after a loss, a count
+//! may have moved on by frames lost, and a step learnt from that would let false frames' counts
+//! through for good. On such a line a near count cannot be frames lost: seen twice, its
+//! distance is a step ([`Counts::take_near`]). (A board that sends each IMU frame in its own
+//! burst leaves a quiet stretch shorter than 10 ms before every IMU frame: a step learnt only
+//! from an unbroken line was never learnt there.)
 
 use crate::telemetry::Stream;
 
@@ -286,15 +289,17 @@ impl Counts {
     /// if its distance is learnt as a step instead.
     ///
     /// Frames lost explain a near count only if the line lost something. When no byte was
-    /// thrown away and the line was never quiet since the stream's last frame, every byte in
-    /// between was a frame taken: none of this stream's can be missing, and the board stepped
+    /// thrown away and the line was not quiet for as long as the stream's period since its last
+    /// frame, every byte in between was a frame taken and no frame of the stream fitted in the
+    /// quiet: none of this stream's can be missing, and the board stepped
     /// its count by that much (one counter shared by all streams steps the IMU by 2 when an
     /// encoder frame came between, a multiple of its usual 1). The same distance seen twice
     /// that way is learnt; once may still be a frame lost whole with nothing else damaged.
     pub fn take_near(&mut self, stream: Stream, count: u8) -> bool {
         let i = stream.index();
         let delta = count.wrapping_sub(self.last(stream));
-        let clean = self.clean(i) && self.quiet_ms.get(i).is_some_and(|q| *q == 0);
+        let period = PERIOD_MS.get(i).copied().unwrap_or(0);
+        let clean = self.clean(i) && self.quiet_ms.get(i).is_some_and(|q| *q < period);
         let Some(seen) = self.near_delta.get_mut(i) else {
             return false;
         };

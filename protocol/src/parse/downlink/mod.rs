@@ -35,7 +35,7 @@
 //! | 6 | Tentative | telemetry, count near (the board paused) | with a header (or quiet line) after it |
 //! | 7 | Tentative | telemetry, the stream's first or a far count | when the chain vouches (far counts in it re-based), or it fills the burst up to the next quiet line |
 //! | 8 | Hunting | telemetry, count continues or near (and fits no other stream) | when the chain vouches (or, the count continuing exactly, the quiet line right after it) |
-//! | 9 | Hunting | telemetry, the stream's first, a count another stream's could explain, or any count inside a frame rejected on a boundary | when its own stream's next frame in the chain continues it |
+//! | 9 | Hunting | telemetry, the stream's first, a count another stream's could explain (but the stream of a frame rejected on a boundary right before it), or any count inside a frame rejected on a boundary | when its own stream's next frame in the chain continues it |
 //! | 10 | Hunting | the awaited reply, not inside a frame rejected on a boundary | when the chain (or a quiet line) vouches, and the chain holds no other reply with its code |
 //! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it); Locked, past a damaged next frame, when the frame after it continues |
 //! | 12 | Hunting | a reply nobody awaits, or the awaited code inside a frame rejected on a boundary | never |
@@ -329,6 +329,12 @@ pub struct DownlinkParser {
     shadow: u8,
     /// The frame before the window was found while hunting (see [`Start::Resynced`]).
     resynced: bool,
+    /// The stream of the telemetry frame last rejected on a boundary (see
+    /// [`other_stream_fits`](Self::other_stream_fits)), and the bytes left until two past its
+    /// end: 1 to 3 at the start of the frame right after it (it lost a byte, had a wrong count
+    /// byte, or gained a byte).
+    rejected: Option<Stream>,
+    rejected_left: u8,
     /// The bytes thrown away right before the window's first byte, newest in the low byte
     /// (row 14: a frame that lost its first byte), and how many of them there are.
     before: u32,
@@ -362,6 +368,8 @@ impl DownlinkParser {
             missing: 0,
             shadow: 0,
             resynced: false,
+            rejected: None,
+            rejected_left: 0,
             before: 0,
             before_len: 0,
             stats: DownlinkStats::new(),
@@ -619,6 +627,7 @@ impl DownlinkParser {
         if frame.is_none() {
             self.counts.quiet(ms);
             self.shadow = 0;
+            self.rejected_left = 0;
             self.before_len = 0;
             if self.lock == Lock::Hunting && !cut {
                 self.lock = Lock::Tentative;
@@ -885,10 +894,19 @@ impl DownlinkParser {
         }
     }
 
-    /// Whether `seq` would continue (or be near) a stream other than `stream`.
+    /// Whether `seq` would continue (or be near) a stream other than `stream`; not counting, for
+    /// a candidate right after a frame rejected on a boundary, that frame's stream: the count
+    /// fits the slot of that damaged frame (one counter shared by all streams, a time tick),
+    /// which is no evidence against the frame after it.
     fn other_stream_fits(&self, stream: Stream, seq: u8, at: usize) -> bool {
+        let explained = if at == 0 && (1..=3).contains(&self.rejected_left) {
+            self.rejected
+        } else {
+            None
+        };
         Stream::ALL.iter().any(|other| {
             *other != stream
+                && Some(*other) != explained
                 && matches!(self.counts.rel(*other, seq, at), Rel::Continues | Rel::Near)
         })
     }
@@ -1165,7 +1183,21 @@ impl DownlinkParser {
             }
             _ => None,
         };
+        let rejected = match (self.lock, self.buf.as_slice()) {
+            (Lock::Locked | Lock::Tentative, [first, second, ..]) => {
+                match Kind::from_header(*first, *second) {
+                    Some(Kind::Telemetry(stream)) => Some(stream),
+                    _ => None,
+                }
+            }
+            _ => None,
+        };
         let first = self.buf.as_slice().first().copied().unwrap_or(0);
+        if let Some(stream) = rejected {
+            self.rejected = Some(stream);
+            self.rejected_left =
+                u8::try_from(Kind::Telemetry(stream).len().saturating_add(2)).unwrap_or(0);
+        }
         self.buf.drop_front(1);
         self.discard(first);
         if let Some(shadow) = shadow {
@@ -1215,6 +1247,9 @@ impl DownlinkParser {
     fn consumed(&mut self, n: usize) {
         self.shadow = self
             .shadow
+            .saturating_sub(u8::try_from(n).unwrap_or(u8::MAX));
+        self.rejected_left = self
+            .rejected_left
             .saturating_sub(u8::try_from(n).unwrap_or(u8::MAX));
         self.counts.bytes(n);
         let mut total = usize::from(self.since_frame).saturating_add(n);
@@ -1281,6 +1316,7 @@ impl DownlinkParser {
         self.counts.bytes(len);
         self.since_frame = 0;
         self.shadow = 0;
+        self.rejected_left = 0;
         self.before_len = 0;
         self.stats.count_frame(kind);
         self.resynced = self.lock == Lock::Hunting;
