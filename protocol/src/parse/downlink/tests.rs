@@ -13,6 +13,19 @@ fn feed(parser: &mut DownlinkParser, bytes: &[u8]) -> Vec<Downlink> {
     bytes.iter().filter_map(|b| parser.push(*b)).collect()
 }
 
+/// Feeds `frame`; if it does not come out on its last byte, notes its count in `late`.
+fn feed_on_time(parser: &mut DownlinkParser, frame: Imu, late: &mut Vec<u8>) -> Vec<Downlink> {
+    let bytes = frame.encode();
+    let (head, last) = bytes.split_at(bytes.len() - 1);
+    let mut out = feed(parser, head);
+    let now = feed(parser, last);
+    if now.last().and_then(Downlink::seq) != Some(frame.seq) {
+        late.push(frame.seq);
+    }
+    out.extend(now);
+    out
+}
+
 fn seqs(frames: &[Downlink]) -> Vec<u8> {
     frames.iter().filter_map(Downlink::seq).collect()
 }
@@ -486,14 +499,7 @@ fn under_a_shared_counter_the_imus_step_after_an_encoder_frame_is_learnt() {
         let mut out = feed(&mut p, &encoders(count).encode());
         for _ in 0..3 {
             count += 1;
-            let frame = imu(count, 7).encode();
-            let (head, last) = frame.split_at(frame.len() - 1);
-            out.extend(feed(&mut p, head));
-            let now = feed(&mut p, last);
-            if now.last().and_then(Downlink::seq) != Some(count) {
-                late.push(count);
-            }
-            out.extend(now);
+            out.extend(feed_on_time(&mut p, imu(count, 7), &mut late));
         }
         out.extend(core::iter::from_fn(|| p.poll()));
         assert_eq!(out.len(), 4, "round {round}: every frame");
@@ -686,6 +692,31 @@ fn row14_hunting_a_frame_in_a_replys_value_whose_tail_is_the_next_frame_is_never
     assert_eq!(out, want);
 }
 
+/// From a quiet line, the clean frames `frame(count)` for `before`, then bytes `received`
+/// (from the sweep), then the clean frames for `after` and a quiet line: every frame out, and
+/// those out after `received`.
+fn replay(
+    frame: &dyn Fn(u16) -> Downlink,
+    before: core::ops::Range<u16>,
+    received: &[u8],
+    after: core::ops::Range<u16>,
+) -> (Vec<Downlink>, Vec<Downlink>) {
+    let mut p = DownlinkParser::new();
+    assert_eq!(p.quiet(1), None);
+    let mut out = Vec::new();
+    for count in before {
+        out.extend(feed(&mut p, &frame(count).encode()));
+    }
+    out.extend(feed(&mut p, received));
+    let mut later = Vec::new();
+    for count in after {
+        later.extend(feed(&mut p, &frame(count).encode()));
+    }
+    later.extend(drain_quiet(&mut p, 1));
+    out.extend(later.iter().cloned());
+    (out, later)
+}
+
 /// Rows 5 and 13, Resynced. Bytes received in the sweep (seed 4242, adversarial payloads, one
 /// counter shared by all streams, 32-byte dropouts): IMU 244 whole; IMU 245 cut after 13 bytes
 /// by a dropout that takes IMU 246, encoder frame 247 and IMU 248's first four bytes; then IMU
@@ -716,19 +747,7 @@ fn row13_right_after_a_frame_found_hunting_a_far_count_needs_its_stream_in_step(
             imu(seq, 0).into()
         }
     };
-    let mut p = DownlinkParser::new();
-    assert_eq!(p.quiet(1), None);
-    let mut out = Vec::new();
-    for count in 202..=243 {
-        out.extend(feed(&mut p, &frame(count).encode()));
-    }
-    out.extend(feed(&mut p, &received));
-    let mut after = Vec::new();
-    for count in 256..=275 {
-        after.extend(feed(&mut p, &frame(count).encode()));
-    }
-    after.extend(drain_quiet(&mut p, 1));
-    out.extend(after.iter().cloned());
+    let (out, after) = replay(&frame, 202..244, &received, 256..276);
     // (The clean frames written here have ticks of 0.)
     let lookalikes: Vec<&Downlink> = out
         .iter()
@@ -774,19 +793,7 @@ fn chain_a_frame_of_the_candidates_stream_sooner_than_its_rate_does_not_vouch() 
             imu(seq, 0).into()
         }
     };
-    let mut p = DownlinkParser::new();
-    assert_eq!(p.quiet(1), None);
-    let mut out = Vec::new();
-    for count in 3..256 + 120 {
-        out.extend(feed(&mut p, &frame(count).encode()));
-    }
-    out.extend(feed(&mut p, &received));
-    let mut after = Vec::new();
-    for count in 256 + 126..256 + 150 {
-        after.extend(feed(&mut p, &frame(count).encode()));
-    }
-    after.extend(drain_quiet(&mut p, 1));
-    out.extend(after.iter().cloned());
+    let (out, after) = replay(&frame, 3..256 + 120, &received, 256 + 126..256 + 150);
     let lookalikes: Vec<&Downlink> = out
         .iter()
         .filter(|f| matches!(f, Downlink::Battery(b) if [251, 121].contains(&b.seq)))
@@ -861,14 +868,7 @@ fn under_a_shared_counter_a_step_is_learnt_across_a_quiet_line_shorter_than_a_pe
         count += 1;
         out.extend(feed(&mut p, &enc(count).encode()));
         count += 1;
-        let frame = imu(count, 7).encode();
-        let (head, last) = frame.split_at(frame.len() - 1);
-        out.extend(feed(&mut p, head));
-        let now = feed(&mut p, last);
-        if now.last().and_then(Downlink::seq) != Some(count) {
-            late.push(count);
-        }
-        out.extend(now);
+        out.extend(feed_on_time(&mut p, imu(count, 7), &mut late));
         out.extend(drain_quiet(&mut p, 8));
         assert_eq!(out.len(), 5, "every frame: {out:?}");
     }
