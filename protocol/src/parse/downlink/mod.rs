@@ -325,15 +325,14 @@ pub struct DownlinkParser {
     /// frame's two header bytes (the first is judged with the second). Until the last one, a
     /// byte is only stored.
     missing: u8,
-    /// Start positions still inside the frame last rejected on a boundary (row 14).
-    shadow: u8,
     /// The frame before the window was found while hunting (see [`Start::Resynced`]).
     resynced: bool,
-    /// The stream of the telemetry frame last rejected on a boundary (see
-    /// [`other_stream_fits`](Self::other_stream_fits)), and the bytes left until two past its
-    /// end: 1 to 3 at the start of the frame right after it (it lost a byte, had a wrong count
-    /// byte, or gained a byte).
-    rejected: Option<Stream>,
+    /// The kind of the frame last rejected on a boundary, and the bytes left until two past its
+    /// end: more than [`MAX_DROPPED`] + 2 at start positions still inside it (row 14, see
+    /// [`in_shadow`](Self::in_shadow)); 1 to 3 at the start of the frame right after it (it
+    /// lost a byte, had a wrong count byte, or gained a byte: see
+    /// [`other_stream_fits`](Self::other_stream_fits)).
+    rejected: Option<Kind>,
     rejected_left: u8,
     /// The bytes thrown away right before the window's first byte, newest in the low byte
     /// (row 14: a frame that lost its first byte), and how many of them there are.
@@ -366,7 +365,6 @@ impl DownlinkParser {
             drain: false,
             since_frame: 0,
             missing: 0,
-            shadow: 0,
             resynced: false,
             rejected: None,
             rejected_left: 0,
@@ -626,7 +624,6 @@ impl DownlinkParser {
         let frame = self.run(true);
         if frame.is_none() {
             self.counts.quiet(ms);
-            self.shadow = 0;
             self.rejected_left = 0;
             self.before_len = 0;
             if self.lock == Lock::Hunting && !cut {
@@ -746,7 +743,7 @@ impl DownlinkParser {
             // row 12.)
             Downlink::Reply(reply)
                 if self.expect == Some(reply.code)
-                    && !(self.lock == Lock::Hunting && self.shadow > 0 && at == 0) =>
+                    && !(self.lock == Lock::Hunting && self.in_shadow() && at == 0) =>
             {
                 Class::Expected {
                     clean: !holds_a_frame_start(reply.encode().get(2..).unwrap_or(&[])),
@@ -755,7 +752,7 @@ impl DownlinkParser {
             Downlink::Reply(_) => Class::Unexpected,
             _ if self.lock == Lock::Hunting
                 && at == 0
-                && (self.shadow > 0 && !self.near(frame) && self.nests_a_frame(frame, &[0])
+                && (self.in_shadow() && !self.near(frame) && self.nests_a_frame(frame, &[0])
                     || self.nests_a_frame(frame, &[1, -1])
                     || self.in_a_replys_value(frame)
                     || self.inside_a_headless_frame(frame)) =>
@@ -768,7 +765,7 @@ impl DownlinkParser {
                     // evidence: row 9.)
                     Rel::Continues | Rel::Near
                         if self.lock == Lock::Hunting
-                            && (self.shadow > 0 && at == 0
+                            && (self.in_shadow() && at == 0
                                 || self.other_stream_fits(stream, seq, at)) =>
                     {
                         Class::Ambiguous
@@ -899,10 +896,11 @@ impl DownlinkParser {
     /// fits the slot of that damaged frame (one counter shared by all streams, a time tick),
     /// which is no evidence against the frame after it.
     fn other_stream_fits(&self, stream: Stream, seq: u8, at: usize) -> bool {
-        let explained = if at == 0 && (1..=3).contains(&self.rejected_left) {
-            self.rejected
-        } else {
-            None
+        let explained = match self.rejected {
+            Some(Kind::Telemetry(rejected)) if at == 0 && (1..=3).contains(&self.rejected_left) => {
+                Some(rejected)
+            }
+            _ => None,
         };
         Stream::ALL.iter().any(|other| {
             *other != stream
@@ -1175,34 +1173,26 @@ impl DownlinkParser {
 
     /// Drops the candidate's first byte and goes hunting.
     fn reject(&mut self) {
-        // A frame rejected on a boundary: the start positions inside it (row 14).
-        let shadow = match (self.lock, self.buf.as_slice()) {
-            (Lock::Locked | Lock::Tentative, [first, second, ..]) => {
-                Kind::from_header(*first, *second)
-                    .map(|kind| kind.len().saturating_sub(MAX_DROPPED.saturating_add(1)))
+        // A frame rejected on a boundary: the start positions inside it (row 14) and right
+        // after it.
+        if let (Lock::Locked | Lock::Tentative, [first, second, ..]) =
+            (self.lock, self.buf.as_slice())
+        {
+            if let Some(kind) = Kind::from_header(*first, *second) {
+                self.rejected = Some(kind);
+                self.rejected_left = u8::try_from(kind.len().saturating_add(2)).unwrap_or(0);
             }
-            _ => None,
-        };
-        let rejected = match (self.lock, self.buf.as_slice()) {
-            (Lock::Locked | Lock::Tentative, [first, second, ..]) => {
-                match Kind::from_header(*first, *second) {
-                    Some(Kind::Telemetry(stream)) => Some(stream),
-                    _ => None,
-                }
-            }
-            _ => None,
-        };
-        let first = self.buf.as_slice().first().copied().unwrap_or(0);
-        if let Some(stream) = rejected {
-            self.rejected = Some(stream);
-            self.rejected_left =
-                u8::try_from(Kind::Telemetry(stream).len().saturating_add(2)).unwrap_or(0);
         }
+        let first = self.buf.as_slice().first().copied().unwrap_or(0);
         self.buf.drop_front(1);
         self.discard(first);
-        if let Some(shadow) = shadow {
-            self.shadow = u8::try_from(shadow).unwrap_or(u8::MAX);
-        }
+    }
+
+    /// Whether the candidate at the front of the window starts inside the frame last rejected
+    /// on a boundary: within the length its header promised, less [`MAX_DROPPED`] bytes it may
+    /// have lost.
+    fn in_shadow(&self) -> bool {
+        usize::from(self.rejected_left) > MAX_DROPPED.saturating_add(2)
     }
 
     /// Counts one byte thrown away (already out of the window, or never in it): `byte`, the
@@ -1245,9 +1235,6 @@ impl DownlinkParser {
     /// `n` bytes left the window (the counts are forgotten each time [`FORGET_AFTER`] bytes
     /// without a frame are reached, as if one byte at a time).
     fn consumed(&mut self, n: usize) {
-        self.shadow = self
-            .shadow
-            .saturating_sub(u8::try_from(n).unwrap_or(u8::MAX));
         self.rejected_left = self
             .rejected_left
             .saturating_sub(u8::try_from(n).unwrap_or(u8::MAX));
@@ -1315,7 +1302,6 @@ impl DownlinkParser {
         self.buf.drop_front(len);
         self.counts.bytes(len);
         self.since_frame = 0;
-        self.shadow = 0;
         self.rejected_left = 0;
         self.before_len = 0;
         self.stats.count_frame(kind);
