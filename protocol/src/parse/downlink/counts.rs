@@ -143,11 +143,14 @@ impl Counts {
     }
 
     /// Which of stream `i`'s learnt steps is `delta`, if one is.
+    #[inline]
     fn step_of(&self, i: usize, delta: u8) -> Option<usize> {
-        self.steps
-            .get(i)?
-            .iter()
-            .position(|s| s.hits > 0 && s.delta == delta)
+        // (A step never learnt has delta 0 and no hits; a learnt one, a delta of 1 to 127 and
+        // hits that only grow: so `delta` names a learnt step when it is not 0.)
+        if delta == 0 {
+            return None;
+        }
+        self.steps.get(i)?.iter().position(|s| s.delta == delta)
     }
 
     /// Stream `i`'s smallest learnt step (1 if none).

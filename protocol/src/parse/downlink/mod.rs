@@ -237,14 +237,13 @@ impl Buf {
             self.compact();
         }
         let end = usize::from(self.end);
-        let mut taken = 0usize;
-        if let Some(dst) = self.bytes.get_mut(end..) {
-            for (d, s) in dst.iter_mut().zip(bytes) {
-                *d = *s;
-                taken = taken.saturating_add(1);
-            }
+        let taken = bytes.len().min(WINDOW.saturating_sub(end));
+        let to = end.saturating_add(taken);
+        match (self.bytes.get_mut(end..to), bytes.get(..taken)) {
+            (Some(dst), Some(src)) => dst.copy_from_slice(src),
+            _ => return 0,
         }
-        self.end = u8::try_from(end.saturating_add(taken)).unwrap_or(self.end);
+        self.end = u8::try_from(to).unwrap_or(self.end);
         taken
     }
 
@@ -253,8 +252,8 @@ impl Buf {
         let (start, end) = (usize::from(self.start), usize::from(self.end));
         let old = self.bytes;
         if let Some(src) = old.get(start..end) {
-            for (d, s) in self.bytes.iter_mut().zip(src) {
-                *d = *s;
+            if let Some(dst) = self.bytes.get_mut(..src.len()) {
+                dst.copy_from_slice(src);
             }
         }
         self.end = self.end.saturating_sub(self.start);
@@ -466,14 +465,10 @@ impl DownlinkParser {
                     continue;
                 }
             }
-            // The window empty on a boundary, a whole frame at the front of `bytes` that row 1
-            // takes: taken straight from the slice, never copied.
-            if self.buf.len() == 0 {
-                if let Some(frame) = aligned_frame(bytes) {
-                    if self.take_aligned(&frame) {
-                        return (Some(frame), bytes.get(frame.kind().len()..).unwrap_or(&[]));
-                    }
-                }
+            // On a boundary, a frame that row 1 takes at the front of the window and `bytes`:
+            // taken without the window.
+            if let Some((frame, used)) = self.take_straight(bytes) {
+                return (Some(frame), bytes.get(used..).unwrap_or(&[]));
             }
             // A frame whose header is (or starts) at the front is taken whole: nothing can be
             // decided before its last byte.
@@ -590,13 +585,62 @@ impl DownlinkParser {
         let Some(step) = self.counts.learnt_step(stream, seq) else {
             return false;
         };
-        self.leave(frame.kind(), frame.kind().len());
+        self.take_learnt(stream, step, seq);
+        true
+    }
+
+    /// Row 1's bookkeeping for a frame of `stream` at the front of the window (or about to be
+    /// consumed from the caller's slice) whose count `seq` is learnt step `step` on.
+    #[inline]
+    fn take_learnt(&mut self, stream: Stream, step: usize, seq: u8) {
+        let kind = Kind::Telemetry(stream);
+        self.leave(kind, kind.len());
         self.counts.take_step(stream, step, seq);
         // The window is empty: the next frame's header is stored, then judged (a junk first
         // byte is rejected with the second as it would have been on its own).
         self.missing = if self.buf.len() == 0 { 2 } else { 0 };
         self.drain = false;
-        true
+    }
+
+    /// The slice path's shortcut: on a boundary, the window empty or holding only the first
+    /// bytes of a telemetry frame, and the rest of that frame at the front of `bytes`. If row 1
+    /// takes it (its count one learnt step on, as in [`take_aligned`](Self::take_aligned)), it
+    /// is taken as if its bytes had been stored one by one (each of them but the last is only
+    /// stored: nothing can be decided before), and the bytes of `bytes` it used are returned
+    /// with it. `None`: nothing done.
+    #[inline]
+    fn take_straight(&mut self, bytes: &[u8]) -> Option<(Downlink, usize)> {
+        if self.lock == Lock::Hunting || self.drain {
+            return None;
+        }
+        let kept = self.buf.as_slice();
+        let (first, second) = match (kept, bytes) {
+            ([], [a, b, ..]) | ([a], [b, ..]) | ([a, b, ..], _) => (*a, *b),
+            _ => return None,
+        };
+        let stream = telemetry_header(&[first, second])?;
+        let len = Kind::Telemetry(stream).len();
+        let used = len
+            .checked_sub(kept.len())
+            .filter(|n| (1..=bytes.len()).contains(n))?;
+        // (The count is a frame's last byte: in `bytes`.)
+        let seq = *bytes.get(used.wrapping_sub(1))?;
+        let step = self.counts.learnt_step(stream, seq)?;
+        let frame = if kept.is_empty() {
+            // Straight from the caller's slice, never copied.
+            decode_telemetry(stream, bytes.get(..len)?)?
+        } else {
+            // A frame cut by the end of the caller's last slice: its two parts, joined.
+            // (`copy_from_slice`, not a loop: a loop's exit at a length that changes every
+            // time is a branch mispredicted every time.)
+            let mut joined = [0u8; telemetry::MAX_LEN];
+            let (head, tail) = joined.split_at_mut_checked(kept.len())?;
+            head.copy_from_slice(kept);
+            tail.get_mut(..used)?.copy_from_slice(bytes.get(..used)?);
+            decode_telemetry(stream, joined.get(..len)?)?
+        };
+        self.take_learnt(stream, step, seq);
+        Some((frame, used))
     }
 
     /// Emits a frame that is already decided in the window, if any, without a new byte.
@@ -1313,16 +1357,17 @@ impl DownlinkParser {
     }
 }
 
-/// The telemetry frame whose header starts `bytes`, if all of it is there.
+/// The telemetry frame of `stream` that `bytes` are, if they are one.
 #[inline]
-fn aligned_frame(bytes: &[u8]) -> Option<Downlink> {
-    let kind = match bytes {
-        [first, second, ..] => Kind::from_header(*first, *second)?,
-        _ => return None,
-    };
-    match kind {
-        Kind::Telemetry(_) => Downlink::decode(bytes.get(..kind.len())?).ok(),
-        Kind::Reply => None,
+fn decode_telemetry(stream: Stream, bytes: &[u8]) -> Option<Downlink> {
+    match stream {
+        Stream::Imu => telemetry::Imu::decode(bytes).ok().map(Downlink::Imu),
+        Stream::Encoders => telemetry::Encoders::decode(bytes)
+            .ok()
+            .map(Downlink::Encoders),
+        Stream::Battery => telemetry::Battery::decode(bytes)
+            .ok()
+            .map(Downlink::Battery),
     }
 }
 
@@ -1381,12 +1426,32 @@ pub struct DownlinkFrames<'p, 'b> {
 impl Iterator for DownlinkFrames<'_, '_> {
     type Item = Downlink;
 
+    #[inline]
     fn next(&mut self) -> Option<Downlink> {
+        // (The common case first, inlined into the caller's loop.)
+        if let Some((frame, used)) = self.parser.take_straight(self.rest) {
+            self.rest = self.rest.get(used..).unwrap_or(&[]);
+            return Some(frame);
+        }
+        if self.rest.is_empty() && !self.parser.drain {
+            return None;
+        }
         let (frame, rest) = self.parser.push_slice(self.rest);
         self.rest = rest;
         frame
     }
 }
+
+// Each telemetry frame's count is its last byte (`take_straight` reads it there).
+const _: () = {
+    let streams = [Stream::Imu, Stream::Encoders, Stream::Battery];
+    let mut i = 0;
+    while i < streams.len() {
+        let stream = streams[i];
+        assert!(stream.seq_at() + 1 == Kind::Telemetry(stream).len());
+        i += 1;
+    }
+};
 
 /// The longest frame, for the window's size check.
 const _: () = assert!(WINDOW >= 3 * telemetry::MAX_LEN + 11 + 6 + 2 * 7);
