@@ -1443,15 +1443,11 @@ impl Iterator for DownlinkFrames<'_, '_> {
 }
 
 // Each telemetry frame's count is its last byte (`take_straight` reads it there).
-const _: () = {
-    let streams = [Stream::Imu, Stream::Encoders, Stream::Battery];
-    let mut i = 0;
-    while i < streams.len() {
-        let stream = streams[i];
-        assert!(stream.seq_at() + 1 == Kind::Telemetry(stream).len());
-        i += 1;
-    }
-};
+const _: () = assert!(
+    Stream::Imu.seq_at() + 1 == Kind::Telemetry(Stream::Imu).len()
+        && Stream::Encoders.seq_at() + 1 == Kind::Telemetry(Stream::Encoders).len()
+        && Stream::Battery.seq_at() + 1 == Kind::Telemetry(Stream::Battery).len()
+);
 
 /// The longest frame, for the window's size check.
 const _: () = assert!(WINDOW >= 3 * telemetry::MAX_LEN + 11 + 6 + 2 * 7);
