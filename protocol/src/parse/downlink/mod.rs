@@ -470,6 +470,9 @@ impl DownlinkParser {
             if let Some((frame, used)) = self.take_straight(bytes) {
                 return (Some(frame), bytes.get(used..).unwrap_or(&[]));
             }
+            if self.store_cut(bytes) {
+                return (None, &[]);
+            }
             // A frame whose header is (or starts) at the front is taken whole: nothing can be
             // decided before its last byte.
             let step = match (self.buf.as_slice(), bytes) {
@@ -641,6 +644,29 @@ impl DownlinkParser {
         };
         self.take_learnt(stream, step, seq);
         Some((frame, used))
+    }
+
+    /// The slice path's other shortcut: the window empty, and `bytes` the first bytes of a
+    /// frame, its header whole, cut by the end of the caller's slice. Nothing can be decided
+    /// before its last byte: they are stored (`true`). `false`: nothing done.
+    #[inline]
+    fn store_cut(&mut self, bytes: &[u8]) -> bool {
+        if self.drain || self.buf.len() > 0 {
+            return false;
+        }
+        let Some(kind) = (match bytes {
+            [first, second, ..] => Kind::from_header(*first, *second),
+            _ => None,
+        }) else {
+            return false;
+        };
+        match kind.len().checked_sub(bytes.len()).filter(|n| *n > 0) {
+            Some(more) if self.buf.extend(bytes) == bytes.len() => {
+                self.wait_for(more);
+                true
+            }
+            _ => false,
+        }
     }
 
     /// Emits a frame that is already decided in the window, if any, without a new byte.
@@ -1434,6 +1460,10 @@ impl Iterator for DownlinkFrames<'_, '_> {
             return Some(frame);
         }
         if self.rest.is_empty() && !self.parser.drain {
+            return None;
+        }
+        if self.parser.store_cut(self.rest) {
+            self.rest = &[];
             return None;
         }
         let (frame, rest) = self.parser.push_slice(self.rest);
