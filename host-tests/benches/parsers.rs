@@ -3,6 +3,9 @@
 //! (SBUS, 25-byte frames, byte at a time), uf-crsf and crsf (CRSF RC-channels packets, 26
 //! bytes, slices). `cargo xtask bench` runs them and prints the table with the ratios.
 //!
+//! Beside them, a floor for byte paths (`StoreOnly`: store each byte, call out of line at a
+//! frame's end, nothing else): what the byte-at-a-time interface itself costs here.
+//!
 //! Streams: about 1 MB each, built here. Ours is the board's telemetry mix at rest (IMU 100 Hz,
 //! encoders 25 Hz, battery 1 Hz, replies), back to back; random bytes for the worst case.
 
@@ -89,6 +92,49 @@ fn ours_slices(bytes: &[u8]) -> usize {
     n
 }
 
+/// A floor for byte paths: a "parser" that only stores each byte through `&mut self`, counts to
+/// a fixed frame length, and at a frame's end calls out of line (as any parser whose frame-end
+/// work is not inlined into the caller's loop does): no header, no check, no decoding. Not a
+/// parser: a reference for what the byte-at-a-time interface itself costs on this machine.
+/// (With a call in the loop, the state lives in memory, and each byte waits for the last
+/// byte's store of it.)
+struct StoreOnly {
+    buf: [u8; 16],
+    pos: u8,
+}
+
+impl StoreOnly {
+    #[inline]
+    fn push(&mut self, byte: u8) -> Option<u8> {
+        if let Some(slot) = self.buf.get_mut(usize::from(self.pos & 15)) {
+            *slot = byte;
+        }
+        self.pos += 1;
+        if self.pos == 15 {
+            return self.frame_end();
+        }
+        None
+    }
+
+    #[inline(never)]
+    fn frame_end(&mut self) -> Option<u8> {
+        self.pos = 0;
+        self.buf.get(14).copied()
+    }
+}
+
+fn store_only_bytewise(bytes: &[u8]) -> usize {
+    let mut floor = StoreOnly {
+        buf: [0; 16],
+        pos: 0,
+    };
+    let mut n = 0;
+    for b in bytes {
+        n += usize::from(floor.push(*b).is_some());
+    }
+    n
+}
+
 fn sbus_bytewise(bytes: &[u8]) -> usize {
     let mut parser = sbus_rs::StreamingParser::new();
     let mut n = 0;
@@ -155,9 +201,14 @@ fn benches(c: &mut Criterion) {
         .sample_size(11)
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(2));
-    let runs: [Run; 7] = [
+    let runs: [Run; 8] = [
         ("byte path: chassis telemetry", &telemetry, ours_bytewise),
         ("byte path: sbus-rs", &sbus, sbus_bytewise),
+        (
+            "byte path: store-only floor",
+            &telemetry,
+            store_only_bytewise,
+        ),
         ("byte path: chassis random bytes", &random, ours_bytewise),
         ("slice path: chassis telemetry", &telemetry, ours_slices),
         ("slice path: uf-crsf", &crsf, uf_crsf_slices),

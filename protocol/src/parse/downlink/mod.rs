@@ -505,7 +505,7 @@ impl DownlinkParser {
     }
 
     /// The bytes just stored may have completed the frame at the front of the window: if it is
-    /// alone there and row 1 takes it ([`take_aligned`](Self::take_aligned)), it is taken
+    /// alone there and row 1 takes it ([`row1_step`](Self::row1_step)), it is taken
     /// without the general judgement; a frame still incomplete waits without it; anything else
     /// is judged. The same decision either way: a shortcut, not a rule.
     #[inline(never)]
@@ -519,10 +519,13 @@ impl DownlinkParser {
                     self.wait_for(more);
                     return None;
                 }
-                if kind.len() == bytes.len() {
-                    if let Ok(frame) = Downlink::decode(bytes) {
-                        // Row 1, the common case, without the general bookkeeping.
-                        if self.take_aligned(&frame) {
+                // Row 1, the common case, without the general bookkeeping.
+                if let (Kind::Telemetry(stream), true, Some(&seq)) =
+                    (kind, kind.len() == bytes.len(), bytes.last())
+                {
+                    if let Some(step) = self.row1_step(stream, seq) {
+                        if let Some(frame) = decode_telemetry(stream, bytes) {
+                            self.take_learnt(stream, step, seq);
                             return Some(frame);
                         }
                     }
@@ -565,12 +568,13 @@ impl DownlinkParser {
         }
     }
 
-    /// Row 1 for `frame`, whose bytes are alone in the window or, the window empty, about to be
-    /// consumed straight from the caller's slice: on a boundary, telemetry whose count is one
-    /// learnt step on is taken at once (`true`), with no judgement and no copy. Anything else
-    /// (`false`, nothing done) goes through the rules: this is a shortcut, not a rule.
+    /// Row 1 as a shortcut, for a telemetry frame of `stream` whose bytes are alone in the
+    /// window or about to be consumed from the caller's slice: on a boundary, a count `seq` one
+    /// learnt step on takes it at once, with no judgement: the step (then
+    /// [`take_learnt`](Self::take_learnt) takes it). `None`: anything else goes through the
+    /// rules. A shortcut, not a rule.
     #[inline]
-    fn take_aligned(&mut self, frame: &Downlink) -> bool {
+    fn row1_step(&self, stream: Stream, seq: u8) -> Option<usize> {
         // (Row 1 holds on a boundary whatever kind of boundary it is.)
         const _: () = assert!(matches!(
             (
@@ -580,16 +584,9 @@ impl DownlinkParser {
             (Need::Now, Need::Now)
         ));
         if self.lock == Lock::Hunting {
-            return false;
+            return None;
         }
-        let (Kind::Telemetry(stream), Some(seq)) = (frame.kind(), frame.seq()) else {
-            return false;
-        };
-        let Some(step) = self.counts.learnt_step(stream, seq) else {
-            return false;
-        };
-        self.take_learnt(stream, step, seq);
-        true
+        self.counts.learnt_step(stream, seq)
     }
 
     /// Row 1's bookkeeping for a frame of `stream` at the front of the window (or about to be
@@ -607,13 +604,13 @@ impl DownlinkParser {
 
     /// The slice path's shortcut: on a boundary, the window empty or holding only the first
     /// bytes of a telemetry frame, and the rest of that frame at the front of `bytes`. If row 1
-    /// takes it (its count one learnt step on, as in [`take_aligned`](Self::take_aligned)), it
+    /// takes it (its count one learnt step on: [`row1_step`](Self::row1_step)), it
     /// is taken as if its bytes had been stored one by one (each of them but the last is only
     /// stored: nothing can be decided before), and the bytes of `bytes` it used are returned
     /// with it. `None`: nothing done.
     #[inline]
     fn take_straight(&mut self, bytes: &[u8]) -> Option<(Downlink, usize)> {
-        if self.lock == Lock::Hunting || self.drain {
+        if self.drain {
             return None;
         }
         let kept = self.buf.as_slice();
@@ -628,7 +625,7 @@ impl DownlinkParser {
             .filter(|n| (1..=bytes.len()).contains(n))?;
         // (The count is a frame's last byte: in `bytes`.)
         let seq = *bytes.get(used.wrapping_sub(1))?;
-        let step = self.counts.learnt_step(stream, seq)?;
+        let step = self.row1_step(stream, seq)?;
         let frame = if kept.is_empty() {
             // Straight from the caller's slice, never copied.
             decode_telemetry(stream, bytes.get(..len)?)?
