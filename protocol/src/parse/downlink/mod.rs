@@ -391,27 +391,39 @@ impl DownlinkParser {
         self.push_slow(byte)
     }
 
-    /// [`push`](Self::push) when a decision may fall: the frame's first bytes and its last take
-    /// short ways; anything else goes through [`push_general`](Self::push_general).
+    /// [`push`](Self::push) when a decision may fall: a frame's last byte and junk with nothing
+    /// before it take short ways here, a frame's first two bytes in
+    /// [`push_decide`](Self::push_decide); anything else goes through
+    /// [`push_general`](Self::push_general).
     #[inline(never)]
     fn push_slow(&mut self, byte: u8) -> Option<Downlink> {
-        if self.missing > 1 {
-            // The window's end is full: the general path makes room.
-        } else if self.missing == 1 && !self.drain {
-            // This byte completes the frame at the front of the window.
-            if self.buf.push(byte) {
-                return self.complete();
+        if !self.drain {
+            if self.missing == 1 {
+                // This byte completes the frame at the front of the window.
+                if self.buf.push(byte) {
+                    return self.complete();
+                }
+            } else if self.missing == 0 && self.buf.len() == 0 && !Kind::may_start(byte) {
+                // A byte that starts no frame, with nothing before it: thrown away at once
+                // (most bytes while hunting through noise: kept apart so that it costs little).
+                self.discard(byte);
+                return None;
             }
-        } else if self.missing == 0 && !self.drain {
+        }
+        self.push_decide(byte)
+    }
+
+    /// [`push_slow`](Self::push_slow) for the bytes its short ways leave.
+    #[inline(never)]
+    fn push_decide(&mut self, byte: u8) -> Option<Downlink> {
+        if self.missing > 1 || self.drain {
+            // The window's end is full (the general path makes room), or a frame is ready.
+        } else if self.missing == 0 {
             // A frame's first two bytes: with the first, nothing can be decided; with the
             // second, the header gives the length to wait for.
             match self.buf.as_slice() {
                 [] => {
-                    // A byte that starts no frame, with nothing before it: thrown away at once.
-                    if !Kind::may_start(byte) {
-                        self.discard(byte);
-                        return None;
-                    }
+                    // (A byte that starts no frame went the short way.)
                     if self.buf.push(byte) {
                         return None;
                     }
@@ -1264,6 +1276,7 @@ impl DownlinkParser {
 
     /// Counts one byte thrown away (already out of the window, or never in it): `byte`, the
     /// one right before the window's first byte now.
+    #[inline]
     fn discard(&mut self, byte: u8) {
         self.before = self.before << 8 | u32::from(byte);
         self.thrown_away(1);
