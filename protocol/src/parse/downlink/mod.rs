@@ -421,22 +421,17 @@ impl DownlinkParser {
         } else if self.missing == 0 {
             // A frame's first two bytes: with the first, nothing can be decided; with the
             // second, the header gives the length to wait for.
-            match self.buf.as_slice() {
-                [] => {
-                    // (A byte that starts no frame went the short way.)
-                    if self.buf.push(byte) {
-                        return None;
-                    }
+            // (A byte that starts no frame went the short way.)
+            let wait = match self.buf.as_slice() {
+                [] => Some(0),
+                &[first] => Kind::from_header(first, byte).map(|kind| kind.len().saturating_sub(2)),
+                _ => None,
+            };
+            if let Some(wait) = wait {
+                if self.buf.push(byte) {
+                    self.missing = u8::try_from(wait).unwrap_or(0);
+                    return None;
                 }
-                &[first] => {
-                    if let Some(kind) = Kind::from_header(first, byte) {
-                        if self.buf.push(byte) {
-                            self.missing = u8::try_from(kind.len().saturating_sub(2)).unwrap_or(0);
-                            return None;
-                        }
-                    }
-                }
-                _ => {}
             }
         }
         self.push_general(byte)
