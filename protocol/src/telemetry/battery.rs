@@ -60,11 +60,17 @@ impl Battery {
     /// Decodes exactly one battery frame.
     pub fn decode(bytes: &[u8]) -> Result<Self, Error> {
         check_frame(bytes, &Self::HEADER, Self::LEN)?;
-        Ok(Battery {
+        bytes.first_chunk().map(Self::read).ok_or(Error::Length)
+    }
+
+    /// The fields of a frame whose header is already checked (the parser's hot path).
+    #[inline]
+    pub(crate) fn read(bytes: &[u8; Self::LEN]) -> Self {
+        Battery {
             centivolts: wire::u16_at(bytes, field::CENTIVOLTS),
             percent: wire::u16_at(bytes, field::PERCENT),
             seq: wire::u8_at(bytes, field::SEQ),
-        })
+        }
     }
 
     /// The voltage in millivolts (exact: 0.01 V = 10 mV).

@@ -59,13 +59,19 @@ impl Encoders {
     /// Decodes exactly one encoder frame.
     pub fn decode(bytes: &[u8]) -> Result<Self, Error> {
         check_frame(bytes, &Self::HEADER, Self::LEN)?;
-        // (Each field by name, not `array::map`: see `Imu::decode`.)
+        bytes.first_chunk().map(Self::read).ok_or(Error::Length)
+    }
+
+    /// The fields of a frame whose header is already checked (the parser's hot path).
+    #[inline]
+    pub(crate) fn read(bytes: &[u8; Self::LEN]) -> Self {
+        // (Each field by name, not `array::map`: see `Imu::read`.)
         let [t0, t1, t2, t3] = field::TICKS;
         let at = |offset| wire::i16_at(bytes, offset);
-        Ok(Encoders {
+        Encoders {
             ticks: [at(t0), at(t1), at(t2), at(t3)],
             seq: wire::u8_at(bytes, field::SEQ),
-        })
+        }
     }
 
     /// Per-motor wrapping difference from an earlier sample: right whether the board sends

@@ -66,15 +66,21 @@ impl Imu {
     /// Decodes exactly one IMU frame.
     pub fn decode(bytes: &[u8]) -> Result<Self, Error> {
         check_frame(bytes, &Self::HEADER, Self::LEN)?;
+        bytes.first_chunk().map(Self::read).ok_or(Error::Length)
+    }
+
+    /// The fields of a frame whose header is already checked (the parser's hot path).
+    #[inline]
+    pub(crate) fn read(bytes: &[u8; Self::LEN]) -> Self {
         // (Each field by name, not `array::map`: that one the optimiser does not always unroll,
         // and this is the parser's hot path.)
         let ([ax, ay, az], [gx, gy, gz]) = (field::ACCEL, field::GYRO);
         let at = |offset| wire::i16_at(bytes, offset);
-        Ok(Imu {
+        Imu {
             accel: [at(ax), at(ay), at(az)],
             gyro: [at(gx), at(gy), at(gz)],
             seq: wire::u8_at(bytes, field::SEQ),
-        })
+        }
     }
 }
 

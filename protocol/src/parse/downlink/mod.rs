@@ -134,9 +134,13 @@
 //!
 //! Parsing state and counters are one [`DownlinkParser`] (size asserted at compile time). While
 //! Locked, a frame's bytes are only stored; on its last byte a count one learnt step on takes
-//! it (row 1) without the general judgement. [`DownlinkParser::push_slice`] takes such a frame
-//! straight from the caller's slice when the window is empty, and otherwise copies a frame's
-//! body in one step. Nothing allocates.
+//! it (row 1) without the general judgement. Through [`DownlinkParser::frames`] (and
+//! [`DownlinkParser::push_slice`]) such a frame is taken straight from the caller's slice,
+//! never copied, when the window is empty; a frame cut by the end of one slice has its first
+//! bytes stored in one step and is joined with the rest at the start of the next. Junk with
+//! nothing before it costs a few instructions a byte. Each of these shortcuts makes the
+//! decision the rules make, as the property tests check (any chunking, same frames). Nothing
+//! allocates.
 //!
 //! # Panics
 //!
@@ -258,6 +262,13 @@ impl Buf {
         }
         self.end = self.end.saturating_sub(self.start);
         self.start = 0;
+    }
+
+    /// Forgets every byte kept.
+    #[inline]
+    fn clear(&mut self) {
+        self.start = 0;
+        self.end = 0;
     }
 
     #[inline]
@@ -600,12 +611,16 @@ impl DownlinkParser {
     /// consumed from the caller's slice) whose count `seq` is learnt step `step` on.
     #[inline]
     fn take_learnt(&mut self, stream: Stream, step: usize, seq: u8) {
+        // ([`leave`](Self::leave) for a frame on a boundary, so not found while hunting, that
+        // is all the window holds, if the window holds anything.)
         let kind = Kind::Telemetry(stream);
-        self.leave(kind, kind.len());
+        self.buf.clear();
+        self.resynced = false;
+        self.left(kind, kind.len());
         self.counts.take_step(stream, step, seq);
         // The window is empty: the next frame's header is stored, then judged (a junk first
         // byte is rejected with the second as it would have been on its own).
-        self.missing = if self.buf.len() == 0 { 2 } else { 0 };
+        self.missing = 2;
         self.drain = false;
     }
 
@@ -635,7 +650,7 @@ impl DownlinkParser {
         let step = self.row1_step(stream, seq)?;
         let frame = if kept.is_empty() {
             // Straight from the caller's slice, never copied.
-            decode_telemetry(stream, bytes.get(..len)?)?
+            decode_telemetry(stream, bytes)?
         } else {
             // A frame cut by the end of the caller's last slice: its two parts, joined.
             // (`copy_from_slice`, not a loop: a loop's exit at a length that changes every
@@ -644,7 +659,7 @@ impl DownlinkParser {
             let (head, tail) = joined.split_at_mut_checked(kept.len())?;
             head.copy_from_slice(kept);
             tail.get_mut(..used)?.copy_from_slice(bytes.get(..used)?);
-            decode_telemetry(stream, joined.get(..len)?)?
+            decode_telemetry(stream, &joined)?
         };
         self.take_learnt(stream, step, seq);
         Some((frame, used))
@@ -1375,29 +1390,40 @@ impl DownlinkParser {
     #[inline]
     fn leave(&mut self, kind: Kind, len: usize) {
         self.buf.drop_front(len);
+        self.resynced = self.lock == Lock::Hunting;
+        if self.lock == Lock::Hunting {
+            self.stats.resyncs = self.stats.resyncs.wrapping_add(1);
+        }
+        self.left(kind, len);
+    }
+
+    /// What every frame taken does to the counters, the counts' clock and the lock, wherever
+    /// its bytes were.
+    #[inline]
+    fn left(&mut self, kind: Kind, len: usize) {
         self.counts.bytes(len);
         self.since_frame = 0;
         self.rejected_left = 0;
         self.before_len = 0;
         self.stats.count_frame(kind);
-        self.resynced = self.lock == Lock::Hunting;
-        if self.lock == Lock::Hunting {
-            self.stats.resyncs = self.stats.resyncs.wrapping_add(1);
-        }
         self.lock = Lock::Locked;
     }
 }
 
-/// The telemetry frame of `stream` that `bytes` are, if they are one.
+/// The telemetry frame of `stream` whose header starts `bytes` (already checked), if all of it
+/// is there (bytes after it are left alone).
 #[inline]
 fn decode_telemetry(stream: Stream, bytes: &[u8]) -> Option<Downlink> {
+    use telemetry::{Battery, Encoders, Imu};
     match stream {
-        Stream::Imu => telemetry::Imu::decode(bytes).ok().map(Downlink::Imu),
-        Stream::Encoders => telemetry::Encoders::decode(bytes)
-            .ok()
+        Stream::Imu => bytes.first_chunk().map(Imu::read).map(Downlink::Imu),
+        Stream::Encoders => bytes
+            .first_chunk()
+            .map(Encoders::read)
             .map(Downlink::Encoders),
-        Stream::Battery => telemetry::Battery::decode(bytes)
-            .ok()
+        Stream::Battery => bytes
+            .first_chunk()
+            .map(Battery::read)
             .map(Downlink::Battery),
     }
 }
