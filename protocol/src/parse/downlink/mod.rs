@@ -410,16 +410,6 @@ impl DownlinkParser {
     fn push_slow(&mut self, byte: u8) -> Option<Downlink> {
         if !self.drain {
             if self.missing == 1 {
-                // The second byte of a header whose first is all the window holds (right after
-                // a frame taken): the header gives the length to wait for.
-                if let [first] = *self.buf.as_slice() {
-                    if let Some(kind) = Kind::from_header(first, byte) {
-                        if self.buf.push(byte) {
-                            self.wait_for(kind.len().saturating_sub(2));
-                            return None;
-                        }
-                    }
-                }
                 // This byte completes the frame at the front of the window.
                 if self.buf.push(byte) {
                     return self.complete();
@@ -558,18 +548,6 @@ impl DownlinkParser {
                         }
                     }
                 }
-            }
-        }
-        self.complete_general()
-    }
-
-    /// [`complete`](Self::complete) past its shortcuts: a reply nobody awaits waits for what
-    /// row 11 needs without the general judgement; anything else is judged. (Apart, so that
-    /// the shortcuts cost little.)
-    #[inline(never)]
-    fn complete_general(&mut self) -> Option<Downlink> {
-        if let [first, second, ..] = *self.buf.as_slice() {
-            if let Some(kind) = Kind::from_header(first, second) {
                 if let Some(more) = self.unawaited_reply_waits(kind, self.buf.as_slice()) {
                     self.wait_for(more);
                     return None;
