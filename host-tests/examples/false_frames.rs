@@ -7,11 +7,12 @@
 //! cargo run --release -p chassis-host-tests --example false_frames -- \
 //!     [--counts p1|p235|shared|tick] [--payload rest|adversarial] \
 //!     [--channel mixed|drops|insertions|dropouts] [--quiet] [--reads] \
-//!     [--seed N] [--frames N] [--show N]
+//!     [--seed N] [--frames N] [--show N] [--context N]
 //! ```
 //!
 //! Defaults: one shared counter, adversarial payloads, drops at 1e-3, nothing reported to the
-//! parser, seed 2026, 1 000 000 frames, 3 shown: the sweep's worst row.
+//! parser, seed 2026, 1 000 000 frames, 3 shown (16 bytes before each, 8 after): the sweep's worst
+//! row.
 
 use chassis_host_tests::board::SentFrame;
 use chassis_host_tests::channel::{Noise, Received, transmit};
@@ -33,6 +34,8 @@ struct Args {
     seed: u64,
     frames: usize,
     show: usize,
+    /// Bytes shown before and after each false frame shown.
+    context: Option<usize>,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -48,6 +51,7 @@ fn parse_args() -> Result<Args, String> {
         seed: 2026,
         frames: 1_000_000,
         show: 3,
+        context: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -101,6 +105,9 @@ fn parse_args() -> Result<Args, String> {
             }
             "--show" => {
                 args.show = usize::try_from(number(value()?)?).map_err(|e| e.to_string())?
+            }
+            "--context" => {
+                args.context = Some(usize::try_from(number(value()?)?).map_err(|e| e.to_string())?)
             }
             other => {
                 return Err(format!(
@@ -198,8 +205,8 @@ fn main() -> ExitCode {
     }
     for f in found.iter().take(args.show) {
         println!("\n{:?}, received bytes {}..={}:", f.frame, f.start, f.end);
-        let lo = f.start.saturating_sub(16);
-        let hi = (f.end + 8).min(rx.bytes.len().saturating_sub(1));
+        let lo = f.start.saturating_sub(args.context.unwrap_or(16));
+        let hi = (f.end + args.context.unwrap_or(8)).min(rx.bytes.len().saturating_sub(1));
         for j in lo..=hi {
             let mark = if (f.start..=f.end).contains(&j) {
                 '*'

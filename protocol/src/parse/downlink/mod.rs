@@ -40,7 +40,7 @@
 //! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it); Locked, past a damaged next frame, when the frame after it continues |
 //! | 12 | Hunting | a reply nobody awaits, or the awaited code inside a frame rejected on a boundary | never |
 //! | 13 | Hunting or Resynced | telemetry, count far | when its own stream's next three frames in the chain move on from it in step (the board restarted its counts) |
-//! | 14 | Hunting | telemetry whose last bytes are a frame of another stream that lost or gained a byte, or, inside a frame rejected on a boundary and with a count not near its own stream's, a whole one; ending on the same count byte, which fits that stream; telemetry that is the tail of a frame of another stream that lost its first byte; or telemetry starting in a reply's value whose tail, from the reply's end, is a whole frame of another stream (same count byte, which fits it) | never (a whole inner frame: the scan reaches it next) |
+//! | 14 | Hunting | telemetry whose last bytes are a frame of another stream that lost or gained a byte, or, inside a frame rejected on a boundary and with a count not near its own stream's, a whole one; ending on the same count byte, which fits that stream; telemetry that is the tail of a frame of another stream that lost its first byte; telemetry starting in a reply's value whose tail, from the reply's end, is a whole frame of another stream (same count byte, which fits it); or, inside a frame rejected on a boundary, telemetry over the header where that frame, a byte short or long, ends | never (a whole inner frame: the scan reaches it next) |
 //! | 15 | any | telemetry, count far, its last two bytes a telemetry header (a cut frame running into the next one) | never |
 //!
 //! *A frame of another stream that lost or gained a byte* (row 14): its header inside the
@@ -72,6 +72,13 @@
 //! `FF FA`, then a real encoder frame; under one counter shared by all streams, or a time tick,
 //! the encoder frame's count continues the IMU stream too.
 //!
+//! *Over the header where the rejected frame ends* (row 14): inside a frame rejected on a
+//! boundary, a telemetry header inside the candidate right where that frame ends if it lost
+//! (or gained) a byte is the next real frame: both cannot be real, and the scan reaches it
+//! next. Lookalikes back to back in adversarial payloads, each a count on from the one before
+//! (under one counter shared by all streams, when the counts pass `FA`..`FC`, payload bytes
+//! are counts too), vouched for each other there, over the real frames.
+//!
 //! *Inside a frame rejected on a boundary* (rows 9, 12 and 14): a candidate that starts within
 //! the length the rejected frame's header promised, less [`MAX_DROPPED`] bytes it may have lost.
 //! A real frame starts there only if the rejected one lost more bytes than that (a dropout), so
@@ -99,7 +106,10 @@
 //! allow on a line that carries IMU frames ([`Counts::too_soon`]: an encoder frame within 60
 //! bytes, a battery frame within 1 500) fails it: both cannot be real (battery lookalikes back
 //! to back in a payload, their counts a learnt step apart by chance). A candidate whose count
-//! continues exactly may have up to two junk bytes before its chain. A quiet line right after
+//! continues exactly may have up to two junk bytes before its chain, unless they are the tail
+//! of a frame from the boundary right before the bytes thrown away ahead of the candidate (its
+//! first `FF`), which lost or gained a byte and ends where the chain starts: the chain vouches
+//! for that frame, not for the candidate inside it. A quiet line right after
 //! the candidate vouches for it after a quiet line (Tentative), for the awaited reply, and,
 //! while hunting, for telemetry whose count continues exactly and fits no other stream,
 //! outside a frame rejected on a boundary (the frame after a damaged one in the same burst);
@@ -841,7 +851,9 @@ impl DownlinkParser {
             Downlink::Reply(_) => Class::Unexpected,
             _ if self.lock == Lock::Hunting
                 && at == 0
-                && (self.in_shadow() && !self.near(frame) && self.nests_a_frame(frame, &[0])
+                && (self.in_shadow()
+                    && (!self.near(frame) && self.nests_a_frame(frame, &[0])
+                        || self.overlaps_the_rejected_frames_next(frame))
                     || self.nests_a_frame(frame, &[1, -1])
                     || self.in_a_replys_value(frame)
                     || self.inside_a_headless_frame(frame)) =>
@@ -868,6 +880,23 @@ impl DownlinkParser {
                 _ => Class::Unexpected,
             },
         }
+    }
+
+    /// Inside a frame rejected on a boundary: whether a telemetry header lies inside the
+    /// candidate `frame` (at the window's front) right where that frame, had it lost or gained a
+    /// byte, would end: where the frame after it starts.
+    fn overlaps_the_rejected_frames_next(&self, frame: &Downlink) -> bool {
+        let end = usize::from(self.rejected_left).saturating_sub(2);
+        let len = frame.kind().len();
+        let buf = self.buf.as_slice();
+        [end.wrapping_sub(1), end.saturating_add(1)]
+            .into_iter()
+            .filter(|at| (1..=len.saturating_sub(2)).contains(at))
+            .any(|at| {
+                buf.get(at..at.saturating_add(2))
+                    .and_then(telemetry_header)
+                    .is_some()
+            })
     }
 
     /// Whether the last two bytes of the candidate `frame`, starting `at` bytes into the window,
@@ -1134,6 +1163,12 @@ impl DownlinkParser {
                     _ => Ok(false),
                 };
             };
+            // Junk between the candidate and its chain that is the tail of a frame from the
+            // boundary before the candidate, which lost or gained a byte: the chain vouches for
+            // that frame, not for the candidate inside it.
+            if at > pos && self.a_damaged_frame_ends_at(at) {
+                return Ok(false);
+            }
             let end = at.saturating_add(kind.len());
             let Some(bytes) = buf.get(at..end) else {
                 return if quiet || end > WINDOW {
@@ -1216,6 +1251,27 @@ impl DownlinkParser {
             pos = end;
             gap = 0;
         }
+    }
+
+    /// Whether a telemetry frame that started on the boundary right before the bytes thrown away
+    /// ahead of the window (one to three of them, the first `FF`) and lost or gained a byte
+    /// would end `at` bytes into the window.
+    fn a_damaged_frame_ends_at(&self, at: usize) -> bool {
+        let thrown = usize::from(self.before_len);
+        let [sync, _] = telemetry::Imu::HEADER;
+        let first = self
+            .before
+            .to_le_bytes()
+            .get(thrown.wrapping_sub(1))
+            .copied();
+        if !(1..=3).contains(&thrown) || first != Some(sync) {
+            return false;
+        }
+        let span = thrown.saturating_add(at);
+        [Stream::Imu, Stream::Encoders, Stream::Battery]
+            .into_iter()
+            .map(|stream| Kind::Telemetry(stream).len())
+            .any(|len| span.saturating_add(1) == len || span == len.saturating_add(1))
     }
 
     /// For a reply nobody awaits on a certain boundary (row 11) whose next frame is damaged:

@@ -66,7 +66,9 @@ pub enum Class {
     /// its own when the scan reaches it. Or telemetry that is the tail of a frame of another
     /// stream that lost its first byte (its lone second header byte just before). Or telemetry
     /// starting in a reply's value whose tail, from the reply's end, is a whole frame of
-    /// another stream (ending on the same count byte, which fits it).
+    /// another stream (ending on the same count byte, which fits it). Or, inside a frame
+    /// rejected on a boundary, telemetry over the header where that frame, a byte short or
+    /// long, ends (the next real frame).
     Nested,
 }
 

@@ -926,3 +926,115 @@ fn row8_a_count_that_fits_the_stream_of_the_frame_rejected_right_before_it_is_no
     }
     assert_eq!(out, want);
 }
+
+/// IMU frames 10 to 14 with encoder frames 50 and 51 among them, from a quiet line, every
+/// payload byte 0; then `received`; then the IMU frames `after` and a quiet line. What came out.
+fn around_a_damaged_imu_15(received: &[u8], after: core::ops::RangeInclusive<u8>) -> Vec<Downlink> {
+    let plain = |seq| Imu {
+        accel: [0; 3],
+        gyro: [0; 3],
+        seq,
+    };
+    let mut p = DownlinkParser::new();
+    assert_eq!(p.quiet(1), None);
+    let mut out = Vec::new();
+    let before: [Downlink; 7] = [
+        plain(10).into(),
+        enc(50).into(),
+        plain(11).into(),
+        plain(12).into(),
+        plain(13).into(),
+        enc(51).into(),
+        plain(14).into(),
+    ];
+    for frame in before {
+        out.extend(feed(&mut p, &frame.encode()));
+    }
+    out.extend(feed(&mut p, received));
+    for seq in after {
+        out.extend(feed(&mut p, &plain(seq).encode()));
+    }
+    out.extend(drain_quiet(&mut p, 1));
+    out
+}
+
+/// Row 8's chain across junk. IMU 15 loses its header's second byte; its accel X is -5
+/// (`FF FB`) and its gyro Z 0x3400, so from its byte 2 an encoder frame with count 52 (its
+/// stream's next) ends on its byte 12. Found while hunting, one byte (`FF`) after the
+/// boundary, its chain is IMU 16 after two junk bytes: IMU 15's last two, the tail of a frame
+/// from the boundary that lost a byte, which ends right where IMU 16 starts. The chain vouches
+/// for that frame, not for the encoder frame inside it. (Before: a false encoder frame 52.)
+#[test]
+fn row8_junk_before_the_chain_that_is_the_tail_of_a_damaged_frame_does_not_vouch() {
+    let damaged = Imu {
+        accel: [-5, 0, 0],
+        gyro: [0, 0, 0x3400],
+        seq: 15,
+    }
+    .encode();
+    let mut received = damaged.to_vec();
+    received.remove(1);
+    let out = around_a_damaged_imu_15(&received, 16..=19);
+    let encoders: Vec<u8> = out
+        .iter()
+        .filter_map(|f| match f {
+            Downlink::Encoders(e) => Some(e.seq),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(encoders, [50, 51], "{out:?}");
+    let imus: Vec<u8> = out
+        .iter()
+        .filter_map(|f| match f {
+            Downlink::Imu(i) => Some(i.seq),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(imus, [10, 11, 12, 13, 14, 16, 17, 18, 19]);
+}
+
+/// Row 14, inside a frame rejected on a boundary: IMU 15 loses its byte 2 and is rejected (its
+/// "count" is IMU 16's first byte). Its gyro Y is -6 (`FF FA`), and so is IMU 16's, whose gyro
+/// X is 15, and IMU 17's gyro X is 16: IMU lookalikes from IMU 15's byte 10 and IMU 16's, back
+/// to back, counts 15 and 16, each continuing the one before. The first overlaps IMU 16's
+/// header, right where IMU 15, one byte short, ends. (Before: both came out, and IMU 16 was
+/// lost.)
+#[test]
+fn row14_inside_a_rejected_frame_a_candidate_over_the_header_where_it_ends_short_is_never_taken() {
+    let imu15 = Imu {
+        accel: [0; 3],
+        gyro: [0, -6, 0],
+        seq: 15,
+    };
+    let imu16 = Imu {
+        accel: [0; 3],
+        gyro: [15, -6, 0],
+        seq: 16,
+    };
+    let imu17 = Imu {
+        accel: [0; 3],
+        gyro: [16, 0, 0],
+        seq: 17,
+    };
+    let mut received = imu15.encode().to_vec();
+    received.remove(2);
+    received.extend(imu16.encode().iter());
+    received.extend(imu17.encode().iter());
+    let out = around_a_damaged_imu_15(&received, 18..=19);
+    let imus: Vec<(u8, [i16; 3])> = out
+        .iter()
+        .filter_map(|f| match f {
+            Downlink::Imu(i) => Some((i.seq, i.gyro)),
+            _ => None,
+        })
+        .collect();
+    let lookalikes: Vec<&(u8, [i16; 3])> = imus
+        .iter()
+        .filter(|(_, gyro)| ![[0, 0, 0], imu16.gyro, imu17.gyro].contains(gyro))
+        .collect();
+    assert!(lookalikes.is_empty(), "{out:?}");
+    assert!(
+        out.contains(&imu16.into()) && out.contains(&imu17.into()),
+        "{out:?}"
+    );
+}
