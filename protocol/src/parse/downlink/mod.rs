@@ -427,7 +427,7 @@ impl DownlinkParser {
             } else if self.missing == 0 && self.buf.len() == 0 && !Kind::may_start(byte) {
                 // A byte that starts no frame, with nothing before it: thrown away at once
                 // (most bytes while hunting through noise: kept apart so that it costs little).
-                self.discard(byte);
+                self.discard_run(&[byte]);
                 return None;
             }
         }
@@ -1056,7 +1056,7 @@ impl DownlinkParser {
                 Verdict::NeedMore(len.saturating_sub(buf.len()))
             };
         };
-        let Ok(frame) = Downlink::decode(bytes) else {
+        let Some(frame) = decode(kind, bytes) else {
             return Verdict::Reject;
         };
         let class = self.class(&frame, 0);
@@ -1177,7 +1177,7 @@ impl DownlinkParser {
                     Err(end.saturating_sub(buf.len()))
                 };
             };
-            let Ok(next) = Downlink::decode(bytes) else {
+            let Some(next) = decode(kind, bytes) else {
                 return Ok(false);
             };
             // The master asked once: an awaited reply whose chain holds another reply with the
@@ -1342,7 +1342,6 @@ impl DownlinkParser {
 
     /// Counts one byte thrown away (already out of the window, or never in it): `byte`, the
     /// one right before the window's first byte now.
-    #[inline]
     fn discard(&mut self, byte: u8) {
         self.before = self.before << 8 | u32::from(byte);
         self.thrown_away(1);
@@ -1481,6 +1480,14 @@ fn decode_telemetry(stream: Stream, bytes: &[u8]) -> Option<Downlink> {
             .first_chunk()
             .map(Battery::read)
             .map(Downlink::Battery),
+    }
+}
+
+/// The frame of `kind` (its header already checked) that `bytes` start with.
+fn decode(kind: Kind, bytes: &[u8]) -> Option<Downlink> {
+    match kind {
+        Kind::Telemetry(stream) => decode_telemetry(stream, bytes),
+        Kind::Reply => telemetry::Reply::decode(bytes).ok().map(Downlink::Reply),
     }
 }
 
