@@ -86,6 +86,9 @@
 //! bytes and the next frame's header in the window, and payload bytes repeat counts. Nor is the
 //! awaited reply's code: `23` and a code in a damaged frame's payload end on its count byte,
 //! right where the next frame starts, so the chain after it vouches as well as for a real one.
+//! Where a frame rejected on a boundary ends if it lost or gained a byte (or had its count byte
+//! changed) is a boundary too: a frame rejected there casts the same shadow (two damaged
+//! frames in a row, the second's payload holding a lookalike over the next frame's header).
 //!
 //! *The master asked once* (row 10): a chain after the awaited reply that holds another reply
 //! with the same code (the real one, after a `23` and the code in a damaged frame's tail) does
@@ -1319,10 +1322,10 @@ impl DownlinkParser {
     /// Drops the candidate's first byte and goes hunting.
     fn reject(&mut self) {
         // A frame rejected on a boundary: the start positions inside it (row 14) and right
-        // after it.
-        if let (Lock::Locked | Lock::Tentative, [first, second, ..]) =
-            (self.lock, self.buf.as_slice())
-        {
+        // after it. (Right where the frame rejected before ends, a byte lost or gained or its
+        // count byte changed, is a boundary too.)
+        let boundary = self.lock != Lock::Hunting || (1..=3).contains(&self.rejected_left);
+        if let (true, [first, second, ..]) = (boundary, self.buf.as_slice()) {
             if let Some(kind) = Kind::from_header(*first, *second) {
                 self.rejected = Some(kind);
                 self.rejected_left = u8::try_from(kind.len().saturating_add(2)).unwrap_or(0);

@@ -1038,3 +1038,58 @@ fn row14_inside_a_rejected_frame_a_candidate_over_the_header_where_it_ends_short
         "{out:?}"
     );
 }
+
+/// Row 14, inside a frame rejected where the frame rejected before it ends. IMU 15 loses its
+/// byte 3 and is rejected on its boundary; IMU 16, right where IMU 15 (a byte short) ends,
+/// loses its byte 13 and is rejected too, while hunting. IMU 16's gyro Y is -6 (`FF FA`): from
+/// its byte 10 an IMU lookalike runs over encoder frame 16's header and ends on its count, which
+/// is near the IMU stream's (and IMU 17 continues it). IMU 16's start is a boundary of sorts:
+/// the lookalike is inside a rejected frame, over the header where that frame, a byte short,
+/// ends. (Before: a false IMU frame 16, and encoder frame 16 lost under it.)
+#[test]
+fn row14_where_a_rejected_frame_ends_a_byte_short_is_a_boundary_for_the_next_rejected_one() {
+    let plain = |seq| Imu {
+        accel: [0; 3],
+        gyro: [0; 3],
+        seq,
+    };
+    let mut p = DownlinkParser::new();
+    assert_eq!(p.quiet(1), None);
+    let mut out = Vec::new();
+    let before: [Downlink; 7] = [
+        plain(10).into(),
+        enc(14).into(),
+        plain(11).into(),
+        plain(12).into(),
+        plain(13).into(),
+        enc(15).into(),
+        plain(14).into(),
+    ];
+    for frame in before {
+        out.extend(feed(&mut p, &frame.encode()));
+    }
+    let mut imu15 = plain(15).encode().to_vec();
+    imu15.remove(3);
+    let imu16 = Imu {
+        accel: [0; 3],
+        gyro: [0, -6, 0],
+        seq: 16,
+    };
+    let mut imu16 = imu16.encode().to_vec();
+    imu16.remove(13);
+    out.extend(feed(&mut p, &imu15));
+    out.extend(feed(&mut p, &imu16));
+    out.extend(feed(&mut p, &enc(16).encode()));
+    for seq in 17..=20 {
+        out.extend(feed(&mut p, &plain(seq).encode()));
+    }
+    out.extend(drain_quiet(&mut p, 1));
+    let imus: Vec<u8> = out
+        .iter()
+        .filter_map(|f| match f {
+            Downlink::Imu(i) => Some(i.seq),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(imus, [10, 11, 12, 13, 14, 17, 18, 19, 20], "{out:?}");
+}
