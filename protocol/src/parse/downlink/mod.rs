@@ -40,7 +40,7 @@
 //! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it); Locked, past a damaged next frame, when the frame after it continues |
 //! | 12 | Hunting | a reply nobody awaits, or the awaited code inside a frame rejected on a boundary | never |
 //! | 13 | Hunting or Resynced | telemetry, count far | when its own stream's next three frames in the chain move on from it in step (the board restarted its counts) |
-//! | 14 | Hunting | telemetry whose last bytes are a frame of another stream that lost or gained a byte, or, inside a frame rejected on a boundary and with a count not near its own stream's, a whole one; ending on the same count byte, which fits that stream; telemetry that is the tail of a frame of another stream that lost its first byte; telemetry starting in a reply's value whose tail, from the reply's end, is a whole frame of another stream (same count byte, which fits it); or, inside a frame rejected on a boundary, telemetry over the header where that frame, a byte short or long, ends | never (a whole inner frame: the scan reaches it next) |
+//! | 14 | Hunting | telemetry whose last bytes are a frame of another stream that lost or gained a byte, or, inside a frame rejected on a boundary and with a count not near its own stream's, a whole one; ending on the same count byte, which fits that stream; telemetry that is the tail of a frame of another stream that lost its first byte; telemetry starting in a reply's value whose tail, from the reply's end, is a whole frame of another stream (same count byte, which fits it); or, inside a frame rejected on a boundary, telemetry over the header where that frame, a byte short or long, ends, or telemetry of its kind from its byte 2 (its tail, had it gained two bytes) | never (a whole inner frame: the scan reaches it next) |
 //! | 15 | any | telemetry, count far, its last two bytes a telemetry header (a cut frame running into the next one) | never |
 //!
 //! *A frame of another stream that lost or gained a byte* (row 14): its header inside the
@@ -77,7 +77,11 @@
 //! (or gained) a byte is the next real frame: both cannot be real, and the scan reaches it
 //! next. Lookalikes back to back in adversarial payloads, each a count on from the one before
 //! (under one counter shared by all streams, when the counts pass `FA`..`FC`, payload bytes
-//! are counts too), vouched for each other there, over the real frames.
+//! are counts too), vouched for each other there, over the real frames. And *its tail from its
+//! byte 2* (row 14): a frame that gained two bytes inside is rejected on its boundary; from its
+//! byte 2, a frame of its kind ends on its count byte, which continues its stream. A real frame
+//! starts there only if a dropout cut the rejected one right after its header and ended right
+//! at a frame's start.
 //!
 //! *Inside a frame rejected on a boundary* (rows 9, 12 and 14): a candidate that starts within
 //! the length the rejected frame's header promised, less [`MAX_DROPPED`] bytes it may have lost.
@@ -856,7 +860,8 @@ impl DownlinkParser {
                 && at == 0
                 && (self.in_shadow()
                     && (!self.near(frame) && self.nests_a_frame(frame, &[0])
-                        || self.overlaps_the_rejected_frames_next(frame))
+                        || self.overlaps_the_rejected_frames_next(frame)
+                        || self.is_the_rejected_frames_tail(frame))
                     || self.nests_a_frame(frame, &[1, -1])
                     || self.in_a_replys_value(frame)
                     || self.inside_a_headless_frame(frame)) =>
@@ -900,6 +905,13 @@ impl DownlinkParser {
                     .and_then(telemetry_header)
                     .is_some()
             })
+    }
+
+    /// Inside a frame rejected on a boundary: whether the candidate `frame` (at the window's
+    /// front) is of the rejected frame's kind and starts two bytes into it, so that it ends
+    /// where that frame ends if it gained two bytes, on its count byte: its payload from there.
+    fn is_the_rejected_frames_tail(&self, frame: &Downlink) -> bool {
+        self.rejected == Some(frame.kind()) && usize::from(self.rejected_left) == frame.kind().len()
     }
 
     /// Whether the last two bytes of the candidate `frame`, starting `at` bytes into the window,

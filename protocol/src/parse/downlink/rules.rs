@@ -68,7 +68,8 @@ pub enum Class {
     /// starting in a reply's value whose tail, from the reply's end, is a whole frame of
     /// another stream (ending on the same count byte, which fits it). Or, inside a frame
     /// rejected on a boundary, telemetry over the header where that frame, a byte short or
-    /// long, ends (the next real frame).
+    /// long, ends (the next real frame), or telemetry of its kind from its byte 2 (its tail,
+    /// had it gained two bytes).
     Nested,
 }
 

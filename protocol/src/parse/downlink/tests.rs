@@ -1093,3 +1093,30 @@ fn row14_where_a_rejected_frame_ends_a_byte_short_is_a_boundary_for_the_next_rej
         .collect();
     assert_eq!(imus, [10, 11, 12, 13, 14, 17, 18, 19, 20], "{out:?}");
 }
+
+/// Row 14, inside a frame rejected on a boundary: IMU 15 gains two bytes inside its payload
+/// and is rejected on its boundary (its "count" is a payload byte). Its accel X is -6 (`FF FA`):
+/// from its byte 2 an IMU lookalike ends on its count byte, 15, which continues the IMU stream
+/// (and IMU 16 continues it). Bytes from a real frame's payload on, however its count fits.
+/// (Before: a false IMU frame 15, its first fields IMU 15's payload.)
+#[test]
+fn row14_a_rejected_frame_that_gained_two_bytes_its_tail_from_byte_2_is_never_taken() {
+    let mut received = Imu {
+        accel: [-6, 0, 0],
+        gyro: [0; 3],
+        seq: 15,
+    }
+    .encode()
+    .to_vec();
+    received.insert(11, 0x66);
+    received.insert(6, 0x55);
+    let out = around_a_damaged_imu_15(&received, 16..=19);
+    let imus: Vec<u8> = out
+        .iter()
+        .filter_map(|f| match f {
+            Downlink::Imu(i) => Some(i.seq),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(imus, [10, 11, 12, 13, 14, 16, 17, 18, 19], "{out:?}");
+}
