@@ -927,32 +927,51 @@ fn row8_a_count_that_fits_the_stream_of_the_frame_rejected_right_before_it_is_no
     assert_eq!(out, want);
 }
 
-/// IMU frames 10 to 14 with encoder frames 50 and 51 among them, from a quiet line, every
-/// payload byte 0; then `received`; then the IMU frames `after` and a quiet line. What came out.
-fn around_a_damaged_imu_15(received: &[u8], after: core::ops::RangeInclusive<u8>) -> Vec<Downlink> {
-    let plain = |seq| Imu {
+/// An IMU frame whose payload bytes are all 0.
+fn plain_imu(seq: u8) -> Imu {
+    Imu {
         accel: [0; 3],
         gyro: [0; 3],
         seq,
-    };
+    }
+}
+
+/// The counts of the IMU frames in `out`.
+fn imu_seqs(out: &[Downlink]) -> Vec<u8> {
+    out.iter()
+        .filter_map(|f| match f {
+            Downlink::Imu(i) => Some(i.seq),
+            _ => None,
+        })
+        .collect()
+}
+
+/// IMU frames 10 to 14 with the encoder frames `encoders` among them, from a quiet line, every
+/// payload byte 0; then `received`; then the IMU frames `after` and a quiet line. What came out.
+fn around_a_damaged_imu_15(
+    encoders: [u8; 2],
+    received: &[u8],
+    after: core::ops::RangeInclusive<u8>,
+) -> Vec<Downlink> {
     let mut p = DownlinkParser::new();
     assert_eq!(p.quiet(1), None);
     let mut out = Vec::new();
+    let [e1, e2] = encoders;
     let before: [Downlink; 7] = [
-        plain(10).into(),
-        enc(50).into(),
-        plain(11).into(),
-        plain(12).into(),
-        plain(13).into(),
-        enc(51).into(),
-        plain(14).into(),
+        plain_imu(10).into(),
+        enc(e1).into(),
+        plain_imu(11).into(),
+        plain_imu(12).into(),
+        plain_imu(13).into(),
+        enc(e2).into(),
+        plain_imu(14).into(),
     ];
     for frame in before {
         out.extend(feed(&mut p, &frame.encode()));
     }
     out.extend(feed(&mut p, received));
     for seq in after {
-        out.extend(feed(&mut p, &plain(seq).encode()));
+        out.extend(feed(&mut p, &plain_imu(seq).encode()));
     }
     out.extend(drain_quiet(&mut p, 1));
     out
@@ -974,7 +993,7 @@ fn row8_junk_before_the_chain_that_is_the_tail_of_a_damaged_frame_does_not_vouch
     .encode();
     let mut received = damaged.to_vec();
     received.remove(1);
-    let out = around_a_damaged_imu_15(&received, 16..=19);
+    let out = around_a_damaged_imu_15([50, 51], &received, 16..=19);
     let encoders: Vec<u8> = out
         .iter()
         .filter_map(|f| match f {
@@ -983,14 +1002,7 @@ fn row8_junk_before_the_chain_that_is_the_tail_of_a_damaged_frame_does_not_vouch
         })
         .collect();
     assert_eq!(encoders, [50, 51], "{out:?}");
-    let imus: Vec<u8> = out
-        .iter()
-        .filter_map(|f| match f {
-            Downlink::Imu(i) => Some(i.seq),
-            _ => None,
-        })
-        .collect();
-    assert_eq!(imus, [10, 11, 12, 13, 14, 16, 17, 18, 19]);
+    assert_eq!(imu_seqs(&out), [10, 11, 12, 13, 14, 16, 17, 18, 19]);
 }
 
 /// Row 14, inside a frame rejected on a boundary: IMU 15 loses its byte 2 and is rejected (its
@@ -1020,7 +1032,7 @@ fn row14_inside_a_rejected_frame_a_candidate_over_the_header_where_it_ends_short
     received.remove(2);
     received.extend(imu16.encode().iter());
     received.extend(imu17.encode().iter());
-    let out = around_a_damaged_imu_15(&received, 18..=19);
+    let out = around_a_damaged_imu_15([50, 51], &received, 18..=19);
     let imus: Vec<(u8, [i16; 3])> = out
         .iter()
         .filter_map(|f| match f {
@@ -1048,28 +1060,8 @@ fn row14_inside_a_rejected_frame_a_candidate_over_the_header_where_it_ends_short
 /// ends. (Before: a false IMU frame 16, and encoder frame 16 lost under it.)
 #[test]
 fn row14_where_a_rejected_frame_ends_a_byte_short_is_a_boundary_for_the_next_rejected_one() {
-    let plain = |seq| Imu {
-        accel: [0; 3],
-        gyro: [0; 3],
-        seq,
-    };
-    let mut p = DownlinkParser::new();
-    assert_eq!(p.quiet(1), None);
-    let mut out = Vec::new();
-    let before: [Downlink; 7] = [
-        plain(10).into(),
-        enc(14).into(),
-        plain(11).into(),
-        plain(12).into(),
-        plain(13).into(),
-        enc(15).into(),
-        plain(14).into(),
-    ];
-    for frame in before {
-        out.extend(feed(&mut p, &frame.encode()));
-    }
-    let mut imu15 = plain(15).encode().to_vec();
-    imu15.remove(3);
+    let mut received = plain_imu(15).encode().to_vec();
+    received.remove(3);
     let imu16 = Imu {
         accel: [0; 3],
         gyro: [0, -6, 0],
@@ -1077,21 +1069,14 @@ fn row14_where_a_rejected_frame_ends_a_byte_short_is_a_boundary_for_the_next_rej
     };
     let mut imu16 = imu16.encode().to_vec();
     imu16.remove(13);
-    out.extend(feed(&mut p, &imu15));
-    out.extend(feed(&mut p, &imu16));
-    out.extend(feed(&mut p, &enc(16).encode()));
-    for seq in 17..=20 {
-        out.extend(feed(&mut p, &plain(seq).encode()));
-    }
-    out.extend(drain_quiet(&mut p, 1));
-    let imus: Vec<u8> = out
-        .iter()
-        .filter_map(|f| match f {
-            Downlink::Imu(i) => Some(i.seq),
-            _ => None,
-        })
-        .collect();
-    assert_eq!(imus, [10, 11, 12, 13, 14, 17, 18, 19, 20], "{out:?}");
+    received.extend(imu16);
+    received.extend(enc(16).encode().iter());
+    let out = around_a_damaged_imu_15([14, 15], &received, 17..=20);
+    assert_eq!(
+        imu_seqs(&out),
+        [10, 11, 12, 13, 14, 17, 18, 19, 20],
+        "{out:?}"
+    );
 }
 
 /// Row 14, inside a frame rejected on a boundary: IMU 15 gains two bytes inside its payload
@@ -1110,13 +1095,10 @@ fn row14_a_rejected_frame_that_gained_two_bytes_its_tail_from_byte_2_is_never_ta
     .to_vec();
     received.insert(11, 0x66);
     received.insert(6, 0x55);
-    let out = around_a_damaged_imu_15(&received, 16..=19);
-    let imus: Vec<u8> = out
-        .iter()
-        .filter_map(|f| match f {
-            Downlink::Imu(i) => Some(i.seq),
-            _ => None,
-        })
-        .collect();
-    assert_eq!(imus, [10, 11, 12, 13, 14, 16, 17, 18, 19], "{out:?}");
+    let out = around_a_damaged_imu_15([50, 51], &received, 16..=19);
+    assert_eq!(
+        imu_seqs(&out),
+        [10, 11, 12, 13, 14, 16, 17, 18, 19],
+        "{out:?}"
+    );
 }
