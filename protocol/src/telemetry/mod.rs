@@ -209,6 +209,37 @@ impl Downlink {
     }
 }
 
+impl Downlink {
+    /// The frame of `kind` whose header starts `bytes` (the caller has checked it): a reply's
+    /// bytes exactly; a telemetry frame's first, if all of it is there (bytes after it are left
+    /// alone). The parser's way in: no second look at a telemetry header, its fields read
+    /// through fixed-size arrays.
+    pub(crate) fn read(kind: Kind, bytes: &[u8]) -> Option<Downlink> {
+        match kind {
+            Kind::Telemetry(stream) => Downlink::read_telemetry(stream, bytes),
+            Kind::Reply => Reply::decode(bytes.get(..Reply::LEN)?)
+                .ok()
+                .map(Downlink::Reply),
+        }
+    }
+
+    /// [`read`](Self::read) for a telemetry frame of `stream`.
+    #[inline]
+    pub(crate) fn read_telemetry(stream: Stream, bytes: &[u8]) -> Option<Downlink> {
+        match stream {
+            Stream::Imu => bytes.first_chunk().map(Imu::read).map(Downlink::Imu),
+            Stream::Encoders => bytes
+                .first_chunk()
+                .map(Encoders::read)
+                .map(Downlink::Encoders),
+            Stream::Battery => bytes
+                .first_chunk()
+                .map(Battery::read)
+                .map(Downlink::Battery),
+        }
+    }
+}
+
 impl From<Imu> for Downlink {
     fn from(f: Imu) -> Self {
         Downlink::Imu(f)

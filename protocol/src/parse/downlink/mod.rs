@@ -559,7 +559,7 @@ impl DownlinkParser {
                     (kind, kind.len() == bytes.len(), bytes.last())
                 {
                     if let Some(step) = self.row1_step(stream, seq) {
-                        if let Some(frame) = decode_telemetry(stream, bytes) {
+                        if let Some(frame) = Downlink::read_telemetry(stream, bytes) {
                             self.take_learnt(stream, step, seq);
                             return Some(frame);
                         }
@@ -667,7 +667,7 @@ impl DownlinkParser {
         let step = self.row1_step(stream, seq)?;
         let frame = if kept.is_empty() {
             // Straight from the caller's slice, never copied.
-            decode_telemetry(stream, bytes)?
+            Downlink::read_telemetry(stream, bytes)?
         } else {
             // A frame cut by the end of the caller's last slice: its two parts, joined.
             // (`copy_from_slice`, not a loop: a loop's exit at a length that changes every
@@ -676,7 +676,7 @@ impl DownlinkParser {
             let (head, tail) = joined.split_at_mut_checked(kept.len())?;
             head.copy_from_slice(kept);
             tail.get_mut(..used)?.copy_from_slice(bytes.get(..used)?);
-            decode_telemetry(stream, &joined)?
+            Downlink::read_telemetry(stream, &joined)?
         };
         self.take_learnt(stream, step, seq);
         Some((frame, used))
@@ -1071,7 +1071,7 @@ impl DownlinkParser {
                 Verdict::NeedMore(len.saturating_sub(buf.len()))
             };
         };
-        let Some(frame) = decode(kind, bytes) else {
+        let Some(frame) = Downlink::read(kind, bytes) else {
             return Verdict::Reject;
         };
         let class = self.class(&frame, 0);
@@ -1192,7 +1192,7 @@ impl DownlinkParser {
                     Err(end.saturating_sub(buf.len()))
                 };
             };
-            let Some(next) = decode(kind, bytes) else {
+            let Some(next) = Downlink::read(kind, bytes) else {
                 return Ok(false);
             };
             // The master asked once: an awaited reply whose chain holds another reply with the
@@ -1477,32 +1477,6 @@ impl DownlinkParser {
         self.before_len = 0;
         self.stats.count_frame(kind);
         self.lock = Lock::Locked;
-    }
-}
-
-/// The telemetry frame of `stream` whose header starts `bytes` (already checked), if all of it
-/// is there (bytes after it are left alone).
-#[inline]
-fn decode_telemetry(stream: Stream, bytes: &[u8]) -> Option<Downlink> {
-    use telemetry::{Battery, Encoders, Imu};
-    match stream {
-        Stream::Imu => bytes.first_chunk().map(Imu::read).map(Downlink::Imu),
-        Stream::Encoders => bytes
-            .first_chunk()
-            .map(Encoders::read)
-            .map(Downlink::Encoders),
-        Stream::Battery => bytes
-            .first_chunk()
-            .map(Battery::read)
-            .map(Downlink::Battery),
-    }
-}
-
-/// The frame of `kind` (its header already checked) that `bytes` start with.
-fn decode(kind: Kind, bytes: &[u8]) -> Option<Downlink> {
-    match kind {
-        Kind::Telemetry(stream) => decode_telemetry(stream, bytes),
-        Kind::Reply => telemetry::Reply::decode(bytes).ok().map(Downlink::Reply),
     }
 }
 
