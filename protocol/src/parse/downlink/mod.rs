@@ -109,7 +109,11 @@
 //! back, reach one whose count continues (or is near) its stream's count, counting the
 //! candidate itself and the chain's frames before it; frames of streams with no count yet pass
 //! it on, replies too; a far count ends it (fails), except on a certain boundary (row 5) where
-//! it re-bases. A frame of the candidate's own stream sooner after it than the board's rates
+//! it re-bases. A frame whose last two bytes are a telemetry header (its count byte the next
+//! header's second, as in row 15) is passed over: its count is no evidence (a frame cut by a
+//! dropout that ended on a header's second byte, re-based on that `FA`, and a lookalike in the
+//! next payload ending on the following header's `FB` continued each other). A frame of the
+//! candidate's own stream sooner after it than the board's rates
 //! allow on a line that carries IMU frames ([`Counts::too_soon`]: an encoder frame within 60
 //! bytes, a battery frame within 1 500) fails it: both cannot be real (battery lookalikes back
 //! to back in a payload, their counts a learnt step apart by chance). A candidate whose count
@@ -1230,6 +1234,19 @@ impl DownlinkParser {
             if let (Kind::Telemetry(stream), Some(seq)) = (next.kind(), next.seq()) {
                 if own == Some(stream) && counts.too_soon(stream, at) {
                     return Ok(false);
+                }
+                // A frame whose count byte is the second byte of a telemetry header (its last
+                // two bytes are one: a cut frame running into the next one, row 15) is no
+                // evidence: passed over.
+                if bytes
+                    .get(kind.len().saturating_sub(2)..)
+                    .and_then(telemetry_header)
+                    .is_some()
+                {
+                    counts.take(stream, seq, false);
+                    pos = end;
+                    gap = 0;
+                    continue;
                 }
                 let own_only = matches!(chain, Chain::Own | Chain::Restart);
                 let mut vouches = !own_only || own == Some(stream);
