@@ -35,7 +35,7 @@
 //! | 6 | Tentative | telemetry, count near (the board paused) | with a header (or quiet line) after it |
 //! | 7 | Tentative | telemetry, the stream's first or a far count | when the chain vouches (far counts in it re-based), or it fills the burst up to the next quiet line |
 //! | 8 | Hunting | telemetry, count continues or near (and fits no other stream) | when the chain vouches (or, the count continuing exactly, the quiet line right after it) |
-//! | 9 | Hunting | telemetry, the stream's first, a count another stream's could explain (but the stream of a frame rejected on a boundary right before it), or any count inside a frame rejected on a boundary | when its own stream's next frame in the chain continues it |
+//! | 9 | Hunting | telemetry, the stream's first, a count another stream's could explain (but the stream of a frame rejected on a boundary right before it), any count inside a frame rejected on a boundary, or a count that is a telemetry header's second byte (its last two bytes a header) | when its own stream's next frame in the chain continues it |
 //! | 10 | Hunting | the awaited reply, not inside a frame rejected on a boundary | when the chain (or a quiet line) vouches, and the chain holds no other reply with its code |
 //! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it); Locked, past a damaged next frame, when the frame after it continues |
 //! | 12 | Hunting | a reply nobody awaits, or the awaited code inside a frame rejected on a boundary | never |
@@ -873,22 +873,26 @@ impl DownlinkParser {
                 Class::Nested
             }
             _ => match (frame.kind(), frame.seq()) {
-                (Kind::Telemetry(stream), Some(seq)) => match self.counts.rel(stream, seq, at) {
-                    // (Inside a frame rejected on a boundary, a continuing count is no
-                    // evidence: row 9.)
-                    Rel::Continues | Rel::Near
-                        if self.lock == Lock::Hunting
-                            && (self.in_shadow() && at == 0
-                                || self.other_stream_fits(stream, seq, at)) =>
-                    {
-                        Class::Ambiguous
+                (Kind::Telemetry(stream), Some(seq)) => {
+                    let cut = self.ends_with_a_header(frame, at);
+                    match self.counts.rel(stream, seq, at) {
+                        // (Inside a frame rejected on a boundary, a continuing count is no
+                        // evidence, nor one that is a header's second byte: row 9.)
+                        Rel::Continues | Rel::Near
+                            if self.lock == Lock::Hunting
+                                && (self.in_shadow() && at == 0
+                                    || self.other_stream_fits(stream, seq, at)
+                                    || cut) =>
+                        {
+                            Class::Ambiguous
+                        }
+                        Rel::Continues => Class::Continues,
+                        Rel::Near => Class::Near,
+                        Rel::Unknown => Class::First,
+                        Rel::Far if cut => Class::Cut,
+                        Rel::Far => Class::Far,
                     }
-                    Rel::Continues => Class::Continues,
-                    Rel::Near => Class::Near,
-                    Rel::Unknown => Class::First,
-                    Rel::Far if self.ends_with_a_header(frame, at) => Class::Cut,
-                    Rel::Far => Class::Far,
-                },
+                }
                 _ => Class::Unexpected,
             },
         }

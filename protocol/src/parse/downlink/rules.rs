@@ -38,8 +38,10 @@ pub enum Class {
     Near,
     /// Telemetry whose count continues (or is near) its stream's, but would continue another
     /// stream's too (what a false frame in a damaged frame's tail, ending on that frame's count
-    /// byte, looks like when the streams share a counter or a time tick), or that starts inside
-    /// a frame rejected on a boundary (where a continuing count is no evidence).
+    /// byte, looks like when the streams share a counter or a time tick), that starts inside
+    /// a frame rejected on a boundary (where a continuing count is no evidence), or whose last
+    /// two bytes are a telemetry header (its count a header's second byte). Judged so only
+    /// while hunting.
     Ambiguous,
     /// Telemetry of a stream with no count known (its first frame, or after forgetting).
     First,
@@ -146,9 +148,9 @@ pub const fn need(start: Start, class: Class) -> Need {
         // 8. Hunting, a plausible count: the next frames must vouch (a count that continues
         //    exactly: or the quiet line right after it).
         (Start::Hunting, Class::Continues | Class::Near) => Need::Chain(Chain::Verify),
-        // 9. Hunting, a stream's first frame, a count another stream's could explain, or any
-        //    count inside a frame rejected on a boundary: its own stream's next frame must
-        //    continue it.
+        // 9. Hunting, a stream's first frame, a count another stream's could explain, any
+        //    count inside a frame rejected on a boundary, or a count that is a header's second
+        //    byte: its own stream's next frame must continue it.
         (Start::Hunting, Class::First | Class::Ambiguous) => Need::Chain(Chain::Own),
         // 10. Hunting, the awaited reply (not inside a frame rejected on a boundary): the next
         //     frames (or the quiet line) must vouch, and hold no other reply with its code.

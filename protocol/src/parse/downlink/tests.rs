@@ -1149,3 +1149,52 @@ fn chain_a_frame_whose_count_is_a_headers_second_byte_does_not_vouch() {
         assert!(out.contains(frame), "{frame:?} lost: {out:?}");
     }
 }
+
+/// Row 9 for telemetry whose last two bytes are a header. IMU 250 has its header's second byte
+/// changed (`FF 99`: hunting from there) and a gyro Z of -6 (`FF FA`); IMU 251's gyro Y is -6
+/// too, so from IMU 250's byte 12 an IMU lookalike ends on IMU 251's byte 11 with count `FA`
+/// (250), continuing IMU 249. IMU 251's gyro Z is -5 (`FF FB`): an encoder lookalike from its
+/// byte 12 whose count (IMU 252's accel Z, 22) continues the encoders. Before: that chain
+/// vouched for the IMU lookalike, and both came out. Now a count that is a header's second
+/// byte found while hunting needs its own stream's next frame (row 9).
+#[test]
+fn row9_hunting_a_count_that_is_a_headers_second_byte_needs_its_own_stream() {
+    let with = |seq: u8, accel_z: i16, gyro_y: i16, gyro_z: i16| -> Downlink {
+        Imu {
+            accel: [0, 0, accel_z],
+            gyro: [0, gyro_y, gyro_z],
+            seq,
+        }
+        .into()
+    };
+    let mut p = DownlinkParser::new();
+    assert_eq!(p.quiet(1), None);
+    let before: [Downlink; 7] = [
+        plain_imu(245).into(),
+        enc(20).into(),
+        plain_imu(246).into(),
+        plain_imu(247).into(),
+        plain_imu(248).into(),
+        enc(21).into(),
+        plain_imu(249).into(),
+    ];
+    let mut out = Vec::new();
+    for frame in &before {
+        out.extend(feed(&mut p, &frame.encode()));
+    }
+    assert_eq!(out, before);
+    let mut damaged = with(250, 0, 0, -6).encode().to_vec();
+    damaged[1] = 0x99;
+    out.extend(feed(&mut p, &damaged));
+    let after = [
+        with(251, 0, -6, -5),
+        with(252, 22, 0, 0),
+        plain_imu(253).into(),
+        plain_imu(254).into(),
+    ];
+    for frame in &after {
+        out.extend(feed(&mut p, &frame.encode()));
+    }
+    out.extend(drain_quiet(&mut p, 1));
+    assert_eq!(out.get(before.len()..), Some(&after[..]), "{out:?}");
+}
