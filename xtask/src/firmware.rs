@@ -332,8 +332,8 @@ pub mod budget {
     /// a reply nobody awaits past a damaged frame (10 776 B): recall was below its goal; raised
     /// to 12 KiB when row 14 learnt damaged inner frames and the tail of a frame that lost its
     /// first byte (11 600 B, about 440 B of judgement): false frames were above their goal.
-    /// (11 984 B after the next stop's rules against false frames and for recall; 12 184 B,
-    /// 104 B left, once every row of the sweep met the false-frame goal.)
+    /// (11 984 B after the next stop's rules against false frames and for recall; 12 124 B,
+    /// 164 B left, once every row of the sweep met the false-frame goal.)
     pub const PROTOCOL_CEILING: u64 = 12 * 1024;
 }
 

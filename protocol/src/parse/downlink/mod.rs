@@ -1242,11 +1242,7 @@ impl DownlinkParser {
                 // A frame whose count byte is the second byte of a telemetry header (its last
                 // two bytes are one: a cut frame running into the next one, row 15) is no
                 // evidence: passed over.
-                if bytes
-                    .get(kind.len().saturating_sub(2)..)
-                    .and_then(telemetry_header)
-                    .is_some()
-                {
+                if self.ends_with_a_header(&next, at) {
                     counts.take(stream, seq, false);
                     pos = end;
                     gap = 0;
