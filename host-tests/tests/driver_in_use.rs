@@ -330,6 +330,7 @@ fn bug4_a_reply_that_does_not_fit_its_register_is_an_error() {
     let mut core = DriverCore::new(Config::DEFAULT);
     core.start(Request::Read(Register::MaxSpeed)).unwrap();
     assert!(core.transmit(0).is_some());
+    core.transmitted(10, 0);
     // Max speed is 16 bits: a reply with its high half set is damaged.
     let _ = core.receive(&[0x23, 0x01, 0x00, 0x01, 0x00, 0x00], 1);
     while core.tick(10).is_some() {}

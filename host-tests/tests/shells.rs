@@ -60,7 +60,7 @@ fn nb_shell_drives_the_board() {
         d.poll().unwrap();
     }
     assert!(d.core().imu().is_some());
-    let (serial, _) = d.release();
+    let (serial, _, _) = d.release();
     let (port, _) = serial.release();
     assert_eq!(port.0.board().total_turn_commanded(), 900);
 }
@@ -149,7 +149,7 @@ fn embedded_io_06_uarts_work_through_the_adapter() {
     d.write(Write::GyroGain(4_242)).unwrap();
     assert_eq!(d.read(reg::GyroGain).unwrap(), 4_242);
     d.set_velocity(Velocity::new(1, 2, 3)).unwrap();
-    let (Io06(uart), _) = d.release();
+    let (Io06(uart), _, _) = d.release();
     assert_eq!(
         uart.0.board().motion(),
         Motion::Velocity { x: 1, y: 2, z: 3 }

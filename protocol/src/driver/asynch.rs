@@ -9,12 +9,23 @@
 //! against a timer. The same calls as the blocking driver, `async`; all policy is the
 //! [`DriverCore`]'s.
 //!
-//! Dropping a request's future (a `select` with a timeout) ends the request: the driver is
-//! never left busy by it.
+//! # Cancellation
+//!
+//! Every method is **cancel-safe** in this sense: dropping its future at any `.await` (a
+//! `select` with a timeout) never puts anything but whole frames on the wire, never leaves the
+//! driver busy, and never sends a turn twice or loses one. What happened of the call is then:
+//!
+//! | method | dropped before its frame is queued | dropped after |
+//! |---|---|---|
+//! | `set_velocity`, `set_motors`, `write`, `action`, `turn` | nothing of it is sent | its frame is sent whole: what the UART did not take yet goes out at the start of the next call (any call, `poll` included) |
+//! | `stop` | the stop is queued at once: it goes out at the start of the next call | as before; a turn's cancel, if one started, ends with the future (the failsafe starts it again if the link dies) |
+//! | `read`, `read_verified`, `read_raw`, `turn_remaining`, `read_settings`, `restore_settings`, `run` | — | the request ends; a read already sent leaves its reply to come as a stray one, and the next read of that register waits for it (or for [`Config::late_reply_ms`](super::Config::late_reply_ms)); frames of a restore already sent stay sent |
+//! | `poll` | — | bytes read stay in the core; nothing is lost |
+//!
+//! The UART's `write` must take no byte when its future is dropped before it completes, as
+//! embassy's `BufferedUart` (and any write that copies into a buffer on its first poll) does.
 
-use super::{
-    Clock, Config, CoreError, DriverCore, Error, Event, Outcome, Readable, Request, RxBuffer,
-};
+use super::{Clock, Config, CoreError, DriverCore, Error, Event, Outcome, Readable, Request};
 use crate::command::{Action, Motors, Register, Turn, Velocity, Write};
 use crate::registers::Snapshot;
 use embassy_futures::select::{Either, select};
@@ -24,12 +35,13 @@ use embedded_io_async::{Read, Write as IoWrite};
 /// The longest [`Driver::poll`] waits when nothing is due, in ms: a loop around it still turns.
 pub const MAX_WAIT_MS: u64 = 10;
 
-/// Waits in a row that see the clock stand still before a request gives up with
-/// [`CoreError::ClockStalled`].
+/// Turns of the pump in a row that see the clock stand still, whatever bytes arrive meanwhile,
+/// before a request gives up with [`CoreError::ClockStalled`].
 pub const STALL_WAITS: u32 = 10_000;
 
-/// The async driver: owns the UART, the clock and the delay (give them back with
-/// [`release`](Driver::release)).
+/// The async driver: owns the UART, the clock and the delay. Everything it knows is in its
+/// [`DriverCore`] ([`release`](Driver::release) gives it back, [`from_core`](Driver::from_core)
+/// takes it again).
 #[derive(Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Driver<U, C, D> {
@@ -37,7 +49,6 @@ pub struct Driver<U, C, D> {
     clock: C,
     delay: D,
     core: DriverCore,
-    rx: RxBuffer,
 }
 
 /// Ends the request in progress if its future is dropped before it finished.
@@ -62,23 +73,39 @@ where
 {
     /// A driver over `uart`, reading time from `clock`, waiting with `delay`.
     pub fn new(uart: U, clock: C, delay: D, config: Config) -> Self {
+        Self::from_core(uart, clock, delay, DriverCore::new(config))
+    }
+
+    /// A driver that goes on from `core` (what [`release`](Driver::release) gave).
+    pub const fn from_core(uart: U, clock: C, delay: D, core: DriverCore) -> Self {
         Driver {
             uart,
             clock,
             delay,
-            core: DriverCore::new(config),
-            rx: RxBuffer::new(),
+            core,
         }
     }
 
-    /// Gives back the UART, the clock and the delay.
-    pub fn release(self) -> (U, C, D) {
-        (self.uart, self.clock, self.delay)
+    /// Gives back the UART, the clock, the delay and the core (keep it for
+    /// [`from_core`](Driver::from_core): it holds the turn guard and a frame half sent).
+    #[must_use = "the core holds the turn guard: pass it to Driver::from_core"]
+    pub fn release(self) -> (U, C, D, DriverCore) {
+        (self.uart, self.clock, self.delay, self.core)
+    }
+
+    /// Changes the configuration, keeping everything the driver knows.
+    pub fn set_config(&mut self, config: Config) {
+        self.core.set_config(config);
     }
 
     /// The UART (to inspect it; the driver keeps it).
     pub const fn uart(&self) -> &U {
         &self.uart
+    }
+
+    /// The UART, mutably (for a test double's controls).
+    pub fn uart_mut(&mut self) -> &mut U {
+        &mut self.uart
     }
 
     /// The sans-IO core.
@@ -94,33 +121,41 @@ where
     /// Sets the body velocity. Safe to call every period.
     pub async fn set_velocity(&mut self, velocity: Velocity) -> Result<(), Error<U::Error>> {
         let now = self.clock.now_ms();
-        let bytes = self.core.velocity(velocity, now);
-        self.send(&bytes).await
+        self.flush_out(now).await?;
+        self.core.velocity(velocity, now)?;
+        self.flush_out(now).await
     }
 
     /// Drives each motor.
     pub async fn set_motors(&mut self, motors: Motors) -> Result<(), Error<U::Error>> {
         let now = self.clock.now_ms();
-        let bytes = self.core.motors(motors, now);
-        self.send(&bytes).await
+        self.flush_out(now).await?;
+        self.core.motors(motors, now)?;
+        self.flush_out(now).await
     }
 
     /// Stops the chassis, and cancels an outstanding turn (see the blocking driver's `stop`).
     pub async fn stop(&mut self) -> Result<(), Error<U::Error>> {
-        let bytes = self.core.stop();
-        self.send(&bytes).await?;
-        if self.core.busy() {
+        let now = self.clock.now_ms();
+        self.core.stop();
+        self.flush_out(now).await?;
+        if self.core.busy_for_user() {
             self.guarded().await.map(|_| ())
         } else {
             Ok(())
         }
     }
 
-    /// Sends a turn once; see [`crate::driver`] for the guard.
+    /// Sends a turn once; see [`crate::driver`] for the guard. A new driver reads the pending
+    /// angle first.
     pub async fn turn(&mut self, turn: Turn) -> Result<(), Error<U::Error>> {
+        if self.core.turn_state() == super::TurnState::Unknown {
+            self.turn_remaining().await?;
+        }
         let now = self.clock.now_ms();
-        let bytes = self.core.turn(turn, now)?;
-        self.send(&bytes).await
+        self.flush_out(now).await?;
+        self.core.turn(turn, now)?;
+        self.flush_out(now).await
     }
 
     /// [`turn`](Driver::turn) by `deci_degrees` (0.1°) standing still.
@@ -164,15 +199,17 @@ where
     /// Writes one register.
     pub async fn write(&mut self, write: Write) -> Result<(), Error<U::Error>> {
         let now = self.clock.now_ms();
-        let bytes = self.core.write(write, now);
-        self.send(&bytes).await
+        self.flush_out(now).await?;
+        self.core.write(write, now)?;
+        self.flush_out(now).await
     }
 
     /// Runs one action.
     pub async fn action(&mut self, action: Action) -> Result<(), Error<U::Error>> {
         let now = self.clock.now_ms();
-        let bytes = self.core.action(action, now);
-        self.send(&bytes).await
+        self.flush_out(now).await?;
+        self.core.action(action, now)?;
+        self.flush_out(now).await
     }
 
     /// Reads every register of a [`Snapshot`], each read verified.
@@ -235,7 +272,7 @@ where
                     return Err(e);
                 }
             };
-            if let Some(outcome) = self.core.settle(now, self.rx.is_empty(), STALL_WAITS) {
+            if let Some(outcome) = self.core.settle(now, STALL_WAITS) {
                 return outcome.map_err(Error::Core);
             }
         }
@@ -245,25 +282,30 @@ where
     async fn pump(&mut self) -> Result<(Option<Event>, u64), Error<U::Error>> {
         let now = self.clock.now_ms();
         self.flush_out(now).await?;
-        if let Some(event) = self.rx.drain(&mut self.core, now) {
+        if let Some(event) = self.core.drain(now) {
             return Ok((Some(event), now));
         }
         let wait = self
             .core
-            .next_deadline()
-            .map_or(MAX_WAIT_MS, |due| due.saturating_sub(now).min(MAX_WAIT_MS));
+            .wait_ms(now)
+            .map_or(MAX_WAIT_MS, |w| w.min(MAX_WAIT_MS));
         let wait = u32::try_from(wait).unwrap_or(u32::MAX);
-        let read = match select(self.uart.read(self.rx.space()), self.delay.delay_ms(wait)).await {
+        let read = match select(
+            self.uart.read(self.core.rx_space()),
+            self.delay.delay_ms(wait),
+        )
+        .await
+        {
             Either::First(read) => Some(read.map_err(Error::Transport)?),
             Either::Second(()) => None,
         };
         let now = self.clock.now_ms();
         if let Some(n) = read {
-            self.rx.filled(n);
-            if let Some(event) = self.rx.drain(&mut self.core, now) {
+            self.core.rx_filled(n);
+            if let Some(event) = self.core.drain(now) {
                 return Ok((Some(event), now));
             }
-            if n >= RxBuffer::LEN {
+            if n >= self.core.rx_space().len() {
                 // The buffer came back full: more is likely waiting. Judge time only once
                 // everything buffered is in.
                 return Ok((None, now));
@@ -274,21 +316,21 @@ where
         Ok((event, now))
     }
 
+    /// Writes out everything the core has to send, a frame a cut write left half sent first.
+    /// Dropped at its `.await`, the bytes the UART has not taken stay in the core.
     async fn flush_out(&mut self, now: u64) -> Result<(), Error<U::Error>> {
-        while let Some(frame) = self.core.transmit(now) {
-            self.send(frame.as_slice()).await?;
-        }
-        Ok(())
-    }
-
-    async fn send(&mut self, mut bytes: &[u8]) -> Result<(), Error<U::Error>> {
-        while !bytes.is_empty() {
+        let mut wrote = false;
+        while let Some(bytes) = self.core.transmit(now) {
             let n = self.uart.write(bytes).await.map_err(Error::Transport)?;
             if n == 0 {
                 return Err(Error::WriteZero);
             }
-            bytes = bytes.get(n..).unwrap_or(&[]);
+            self.core.transmitted(n, now);
+            wrote = true;
         }
-        self.uart.flush().await.map_err(Error::Transport)
+        if wrote {
+            self.uart.flush().await.map_err(Error::Transport)?;
+        }
+        Ok(())
     }
 }

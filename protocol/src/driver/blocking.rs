@@ -22,27 +22,32 @@
 //! # Ok::<(), chassis_protocol::driver::Error<core::convert::Infallible>>(())
 //! ```
 
-use super::{
-    Clock, Config, CoreError, DriverCore, Error, Event, Outcome, Readable, Request, RxBuffer,
-};
+use super::{Clock, Config, CoreError, DriverCore, Error, Event, Outcome, Readable, Request};
 use crate::command::{Action, Motors, Register, Turn, Velocity, Write};
 use crate::registers::Snapshot;
 use embedded_io::{Read, ReadReady, Write as IoWrite};
 
-/// Polls in a row that see the clock stand still and no byte come before a wait gives up with
-/// [`CoreError::ClockStalled`] (a millisecond clock that never moves would otherwise hang a read).
-/// A million polls take far longer than a millisecond on any microcontroller.
+/// Polls in a row that see the clock stand still before a wait gives up with
+/// [`CoreError::ClockStalled`], whatever bytes arrive meanwhile (a millisecond clock that never
+/// moves would otherwise hang a read). A million polls take far longer than a millisecond on
+/// any microcontroller.
 pub const STALL_POLLS: u32 = 1_000_000;
 
-/// The blocking driver: owns the UART and the clock (give them back with
-/// [`release`](Driver::release)); bytes read but not yet parsed are kept between calls.
+/// Reads (of up to 32 bytes each) one poll makes at most before it judges time and returns: a
+/// UART that never runs dry cannot keep a call from ending. 128 reads is 4 KiB, more than a
+/// second of the board's line.
+pub const POLL_READS: u32 = 128;
+
+/// The blocking driver: owns the UART and the clock. Everything it knows (the turn guard, bytes
+/// read and not yet parsed, a frame half sent, the latest telemetry) is in its
+/// [`DriverCore`], which [`release`](Driver::release) gives back with them and
+/// [`from_core`](Driver::from_core) takes again.
 #[derive(Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Driver<U, C> {
     uart: U,
     clock: C,
     core: DriverCore,
-    rx: RxBuffer,
 }
 
 impl<U, C> Driver<U, C>
@@ -52,17 +57,26 @@ where
 {
     /// A driver over `uart`, reading time from `clock`.
     pub fn new(uart: U, clock: C, config: Config) -> Self {
-        Driver {
-            uart,
-            clock,
-            core: DriverCore::new(config),
-            rx: RxBuffer::new(),
-        }
+        Self::from_core(uart, clock, DriverCore::new(config))
     }
 
-    /// Gives back the UART and the clock.
-    pub fn release(self) -> (U, C) {
-        (self.uart, self.clock)
+    /// A driver that goes on from `core` (what [`release`](Driver::release) gave): the turn
+    /// guard, bytes already read and a frame half sent carry over.
+    pub const fn from_core(uart: U, clock: C, core: DriverCore) -> Self {
+        Driver { uart, clock, core }
+    }
+
+    /// Gives back the UART, the clock and the core. Keep the core and hand it to
+    /// [`from_core`](Driver::from_core) to go on: a new core does not know a turn this one
+    /// sent.
+    #[must_use = "the core holds the turn guard: pass it to Driver::from_core"]
+    pub fn release(self) -> (U, C, DriverCore) {
+        (self.uart, self.clock, self.core)
+    }
+
+    /// Changes the configuration, keeping everything the driver knows.
+    pub fn set_config(&mut self, config: Config) {
+        self.core.set_config(config);
     }
 
     /// The UART (to inspect it; the driver keeps it).
@@ -89,23 +103,27 @@ where
     /// Sets the body velocity (see [`Velocity`] for the drive types). Safe to call every period.
     pub fn set_velocity(&mut self, velocity: Velocity) -> Result<(), Error<U::Error>> {
         let now = self.clock.now_ms();
-        let bytes = self.core.velocity(velocity, now);
-        self.send(&bytes)
+        self.flush_out(now)?;
+        self.core.velocity(velocity, now)?;
+        self.flush_out(now)
     }
 
     /// Drives each motor ([`Motors::closed_loop`] or [`Motors::open_loop_duty`]).
     pub fn set_motors(&mut self, motors: Motors) -> Result<(), Error<U::Error>> {
         let now = self.clock.now_ms();
-        let bytes = self.core.motors(motors, now);
-        self.send(&bytes)
+        self.flush_out(now)?;
+        self.core.motors(motors, now)?;
+        self.flush_out(now)
     }
 
     /// Stops the chassis; if a turn is outstanding, cancels it too (reads the angle still
-    /// pending and sends the opposite turn) and returns when that is done.
+    /// pending and sends the opposite turn) and returns when that is done. A frame a cut write
+    /// left half sent is finished first: nothing else can go before it.
     pub fn stop(&mut self) -> Result<(), Error<U::Error>> {
-        let bytes = self.core.stop();
-        self.send(&bytes)?;
-        if self.core.busy() {
+        let now = self.clock.now_ms();
+        self.core.stop();
+        self.flush_out(now)?;
+        if self.core.busy_for_user() {
             self.finish().map(|_| ())
         } else {
             Ok(())
@@ -114,11 +132,16 @@ where
 
     /// Sends a turn, **once**: the turn is consumed, and while one is outstanding a new one is
     /// [`CoreError::TurnInProgress`]. [`turn_remaining`](Driver::turn_remaining) reading (nearly)
-    /// 0 ends it; [`stop`](Driver::stop) cancels it.
+    /// 0 ends it; [`stop`](Driver::stop) cancels it. A new driver reads the pending angle first
+    /// (an earlier one may have left the board turning).
     pub fn turn(&mut self, turn: Turn) -> Result<(), Error<U::Error>> {
+        if self.core.turn_state() == super::TurnState::Unknown {
+            self.turn_remaining()?;
+        }
         let now = self.clock.now_ms();
-        let bytes = self.core.turn(turn, now)?;
-        self.send(&bytes)
+        self.flush_out(now)?;
+        self.core.turn(turn, now)?;
+        self.flush_out(now)
     }
 
     /// [`turn`](Driver::turn) by `deci_degrees` (0.1°) standing still.
@@ -161,15 +184,17 @@ where
     /// Writes one register (2B). The board does not answer writes.
     pub fn write(&mut self, write: Write) -> Result<(), Error<U::Error>> {
         let now = self.clock.now_ms();
-        let bytes = self.core.write(write, now);
-        self.send(&bytes)
+        self.flush_out(now)?;
+        self.core.write(write, now)?;
+        self.flush_out(now)
     }
 
     /// Runs one action (2A).
     pub fn action(&mut self, action: Action) -> Result<(), Error<U::Error>> {
         let now = self.clock.now_ms();
-        let bytes = self.core.action(action, now);
-        self.send(&bytes)
+        self.flush_out(now)?;
+        self.core.action(action, now)?;
+        self.flush_out(now)
     }
 
     /// Reads every register of a [`Snapshot`], each read verified.
@@ -192,9 +217,9 @@ where
     }
 
     /// Takes in what has arrived, without blocking: returns the first event, if any. Once every
-    /// byte the UART holds is in, it judges time (quiet line, reply timeouts, the failsafe) and
-    /// sends what the core has queued (a failsafe stop). Call it often: every loop, or from the
-    /// UART interrupt.
+    /// byte the UART holds is in (or [`POLL_READS`] reads), it judges time (quiet line, reply
+    /// timeouts, the failsafe) and sends what the core has queued (a failsafe stop). Call it
+    /// often: every loop, or from the UART interrupt.
     pub fn poll(&mut self) -> Result<Option<Event>, Error<U::Error>> {
         let now = self.clock.now_ms();
         let result = self.pump(now);
@@ -219,7 +244,7 @@ where
                 self.core.abort();
                 return Err(e);
             }
-            if let Some(outcome) = self.core.settle(now, self.rx.is_empty(), STALL_POLLS) {
+            if let Some(outcome) = self.core.settle(now, STALL_POLLS) {
                 return outcome.map_err(Error::Core);
             }
         }
@@ -227,15 +252,20 @@ where
 
     fn pump(&mut self, now: u64) -> Result<Option<Event>, Error<U::Error>> {
         self.flush_out(now)?;
+        let mut reads = 0;
         loop {
-            if let Some(event) = self.rx.drain(&mut self.core, now) {
+            if let Some(event) = self.core.drain(now) {
                 return Ok(Some(event));
             }
-            if !self.uart.read_ready().map_err(Error::Transport)? {
+            if reads >= POLL_READS || !self.uart.read_ready().map_err(Error::Transport)? {
                 break;
             }
-            let n = self.uart.read(self.rx.space()).map_err(Error::Transport)?;
-            self.rx.filled(n);
+            let n = self
+                .uart
+                .read(self.core.rx_space())
+                .map_err(Error::Transport)?;
+            self.core.rx_filled(n);
+            reads = reads.saturating_add(1);
             if n == 0 {
                 break;
             }
@@ -245,23 +275,21 @@ where
         Ok(event)
     }
 
-    /// Sends every frame the core has queued.
+    /// Writes out everything the core has to send, a frame a cut write left half sent first
+    /// (a `write` of 0 is [`Error::WriteZero`], not a panic), and flushes.
     fn flush_out(&mut self, now: u64) -> Result<(), Error<U::Error>> {
-        while let Some(frame) = self.core.transmit(now) {
-            self.send(frame.as_slice())?;
-        }
-        Ok(())
-    }
-
-    /// Writes all of `bytes` (a `write` of 0 is [`Error::WriteZero`], not a panic) and flushes.
-    fn send(&mut self, mut bytes: &[u8]) -> Result<(), Error<U::Error>> {
-        while !bytes.is_empty() {
+        let mut wrote = false;
+        while let Some(bytes) = self.core.transmit(now) {
             let n = self.uart.write(bytes).map_err(Error::Transport)?;
             if n == 0 {
                 return Err(Error::WriteZero);
             }
-            bytes = bytes.get(n..).unwrap_or(&[]);
+            self.core.transmitted(n, now);
+            wrote = true;
         }
-        self.uart.flush().map_err(Error::Transport)
+        if wrote {
+            self.uart.flush().map_err(Error::Transport)?;
+        }
+        Ok(())
     }
 }

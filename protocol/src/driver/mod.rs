@@ -93,11 +93,13 @@ pub mod host;
 pub mod io06;
 #[cfg(feature = "nb")]
 pub mod nb;
+mod safety;
 mod sans_io;
 mod split;
+mod time;
 
 pub use crate::registers::{BatteryRange, Readable, Snapshot, reg};
-pub use sans_io::{DriverCore, Event, Outcome, Outgoing, Request, RxBuffer, Stamped, StreamInfo};
+pub use sans_io::{DriverCore, Event, Outcome, Outgoing, Request, Stamped, StreamInfo, TurnState};
 pub use split::Split;
 
 use crate::command::Register;
@@ -139,6 +141,10 @@ pub struct Config {
     pub turn_done_deci_degrees: u16,
     /// Reads sent at most by a verified read ([`Request::ReadVerified`]).
     pub read_tries: u8,
+    /// How long after a read's timeout its reply may still come, in ms. Until it has come, or
+    /// this has passed, a read of the same register is not sent (the two replies could not be
+    /// told apart), and a late reply makes later reads wait longer (at most this much more).
+    pub late_reply_ms: u32,
 }
 
 impl Config {
@@ -152,16 +158,18 @@ impl Config {
         idle_ms: 2,
         turn_done_deci_degrees: 5,
         read_tries: 4,
+        late_reply_ms: 150,
     };
 
     /// A PC or a Raspberry Pi behind a USB-UART adapter: the adapter hands bytes over in bursts
     /// every 1 to 16 ms (its latency timer), both ways, and the OS adds its own scheduling. So a
     /// quiet line is 40 ms (no burst gap inside a frame is mistaken for one), replies get 40 ms
-    /// more, and the failsafe is 200 ms.
+    /// more, the failsafe is 200 ms, and a late reply is awaited 300 ms more.
     pub const HOST: Config = Config {
         board_latency_ms: 90,
         failsafe_ms: 200,
         idle_ms: 40,
+        late_reply_ms: 300,
         ..Config::DEFAULT
     };
 
@@ -224,6 +232,12 @@ pub enum CoreError {
     Aborted,
     /// The clock stood still while a request waited: time never came to end the wait.
     ClockStalled,
+    /// A frame is still to go out (the rest of one a cut write left, a stop, a request's
+    /// frame): write out what [`DriverCore::transmit`] gives first. The shells always do.
+    FramePending,
+    /// Whether the board still has a turn pending is not known (a new driver has not read the
+    /// pending angle yet): read it first. The shells do it before the first turn.
+    TurnStateUnknown,
 }
 
 impl fmt::Display for CoreError {
@@ -241,6 +255,10 @@ impl fmt::Display for CoreError {
             CoreError::TurnInProgress => f.write_str("a turn is still outstanding"),
             CoreError::Aborted => f.write_str("the request was ended by a stop"),
             CoreError::ClockStalled => f.write_str("the clock stood still while waiting"),
+            CoreError::FramePending => f.write_str("a frame is still being sent"),
+            CoreError::TurnStateUnknown => {
+                f.write_str("whether a turn is pending is not known: read the pending angle first")
+            }
         }
     }
 }
