@@ -1110,6 +1110,14 @@ impl DriverCore {
             }
         };
         let matches = read.register.reply_code() == reply.code;
+        if matches {
+            // Answered in time: the learnt round trip moves back towards what the board does.
+            if let Phase::Waiting { sent_ms, .. } = read.phase {
+                let rtt = u32::try_from(now.saturating_sub(sent_ms)).unwrap_or(u32::MAX);
+                let decayed = self.late_rtt_ms.saturating_sub(self.late_rtt_ms / 8);
+                self.late_rtt_ms = decayed.max(rtt.min(self.late_rtt_ms));
+            }
+        }
         if !matches && self.take_ghost(reply.code, now) {
             // The late reply to an earlier read: the read in flight waits on.
             return Event::StrayReply(reply);
@@ -1196,7 +1204,15 @@ impl DriverCore {
             return;
         };
         match read.phase {
-            Phase::Waiting { deadline_ms, .. } if now > deadline_ms => {
+            Phase::Waiting {
+                sent_ms,
+                deadline_ms,
+            } if now > deadline_ms => {
+                // No answer in the time given: the board may be slower than that. Reads from
+                // now on wait twice as long (at most `late_reply_ms` more than configured)
+                // until replies show otherwise.
+                let waited = u32::try_from(deadline_ms.saturating_sub(sent_ms)).unwrap_or(u32::MAX);
+                self.late_rtt_ms = self.late_rtt_ms.max(waited.saturating_mul(2));
                 self.unanswered(&read);
                 match read.check {
                     Check::Once => self.finish(Err(CoreError::Timeout(read.register))),
