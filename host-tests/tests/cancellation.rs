@@ -16,7 +16,7 @@ use chassis_protocol::{Action, Motors, Velocity, Write};
 use core::cell::Cell;
 use core::future::Future;
 use core::pin::Pin;
-use core::task::{Context, Poll, Waker};
+use core::task::{Context, Waker};
 use embedded_io::ReadReady;
 
 // ----- the frames the board may receive, by hand from the spec -----
@@ -430,7 +430,7 @@ fn every_async_call_cut_at_every_await_point_leaves_only_whole_frames_and_a_work
                     let mut future = call_async(&mut d, call);
                     let mut finished = false;
                     for _ in 0..polls {
-                        if let Poll::Ready(_) = future.as_mut().poll(&mut cx) {
+                        if future.as_mut().poll(&mut cx).is_ready() {
                             finished = true;
                             break;
                         }

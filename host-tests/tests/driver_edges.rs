@@ -39,7 +39,7 @@ impl embedded_io::ErrorType for Streaming<'_> {
 impl ReadReady for Streaming<'_> {
     fn read_ready(&mut self) -> Result<bool, Infallible> {
         self.polls += 1;
-        if self.polls % self.polls_per_ms == 0 {
+        if self.polls.is_multiple_of(self.polls_per_ms) {
             self.time.set(self.time.get() + 1);
         }
         self.uart.read_ready()
@@ -332,13 +332,13 @@ fn imu_frames_through_reconfiguration(reconfigure: bool) -> u32 {
     let mut failsafe_ms = 100;
     while time.get() < 3_000 {
         d.poll().unwrap();
-        if reconfigure && time.get() % 7 == 0 {
+        if reconfigure && time.get().is_multiple_of(7) {
             failsafe_ms = if failsafe_ms == 100 { 150 } else { 100 };
             let config = Config {
                 failsafe_ms,
                 ..Config::DEFAULT
             };
-            if time.get() % 2 == 0 {
+            if time.get().is_multiple_of(2) {
                 d.set_config(config);
             } else {
                 let (uart, clock, mut core) = d.release();
