@@ -322,6 +322,21 @@ fn case5_the_turn_guard_survives_release_and_a_new_driver() {
     assert_eq!(d.uart().board().total_turn_commanded(), 900, "before: 1800");
 }
 
+#[test]
+fn case5_a_cloned_turn_is_refused_while_the_first_runs() {
+    let time = Cell::new(0);
+    let mut d = Driver::new(
+        board(SimConfig::default(), &time),
+        SimClock(&time),
+        Config::DEFAULT,
+    );
+    let turn = chassis_protocol::Turn::by_deci_degrees(900);
+    let again = turn.clone();
+    d.turn(turn).unwrap();
+    assert_eq!(d.turn(again), Err(Error::Core(CoreError::TurnInProgress)));
+    assert_eq!(d.uart().board().total_turn_commanded(), 900);
+}
+
 /// Three seconds of a turn and telemetry through 8 ms bursts; with `reconfigure`, the config
 /// changed every 7 ms, in place or through release and rebuild. IMU frames received.
 fn imu_frames_through_reconfiguration(reconfigure: bool) -> u32 {

@@ -277,6 +277,10 @@ pub enum VelocityReading {
 /// let first = turn.encode();
 /// let again = turn.encode(); // error: `turn` was consumed by the first send
 /// ```
+///
+/// It is `Clone`, and cloning is safe: a clone is a second turn asked for in so many words, and
+/// the [driver](crate)'s turn guard refuses it while the first is outstanding (test
+/// `case5_a_cloned_turn_is_refused_while_the_first_runs`).
 // Not `Copy`: sending a turn consumes it ([`Turn::encode`] takes `self`), so one value cannot be
 // sent twice by accident; a second turn is a second value (or an explicit `clone`).
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]

@@ -24,14 +24,42 @@
 //! | stm32f4xx-hal 0.23 | `Serial` | embedded-hal-nb 1.0; of embedded-io 0.6 only `Write` | `NbSerial` (not `Io06`: no 0.6 `Read`) |
 //! | esp-hal 1.x | `Uart` | embedded-io 0.7 behind its `unstable` feature; no embedded-hal-nb | [`blocking::Driver`] with esp-hal's `unstable` on |
 //!
+//! # The safety model
+//!
+//! Every way the driver stops the chassis, or keeps it from doing what nobody asked, with its
+//! bound and the test that proves it (in `host-tests/tests/` unless named otherwise). Times are
+//! [`Config::DEFAULT`]'s (a microcontroller's UART); [`Config::HOST`] (a PC or a Raspberry Pi
+//! behind a USB-UART) has a 200 ms failsafe and a 133 ms reply timeout.
+//!
+//! | what | what the driver does | bound | test |
+//! |---|---|---|---|
+//! | **the board goes silent while moving** (the failsafe) | sends STOP once no frame of any kind (telemetry or reply) has been heard for [`Config::failsafe_ms`], or for [`Config::settings_pause_ms`] after a settings frame until telemetry is back; judged only once every byte the UART holds is read, so a slow loop never stops a healthy robot | 100 ms of silence (200 on a host), plus the time to your next `poll` | `driver_in_use::bug2_a_silent_board_is_stopped_within_the_limit`, `driver_edges::case4_the_failsafe_stops_across_the_wrap` |
+//! | **`stop()`** | queues STOP ahead of everything not yet begun; a frame a cut write left half sent is finished first (it must be: the board's parser holds its start); cancels an outstanding turn (reads the pending angle, sends the opposite) | at most 11 bytes before the STOP (1 ms at 115 200 bps) | `cancellation::a_half_sent_turn_then_stop_never_spins_the_board`, `driver_in_use::bug7_stop_cancels_a_pending_turn` |
+//! | **a turn outstanding when the link dies** | the failsafe's STOP ends any translation; a stop frame does not end a turn on this board, and only the opposite angle cancels it, which needs the angle still pending: the driver keeps asking for it (in the background, a request you start goes first) and cancels what is left at the first reply. `stop()` with its replies lost returns [`CoreError::Unconfirmed`] and the guard holds | the chassis turns at most the angle it was told; it stops turning within a reply's round trip (and one retry) of the link coming back | `driver_edges::case6_a_turn_outstanding_when_the_link_dies_is_cancelled_at_the_first_reply` |
+//! | **an async call cancelled** (a `select` with a timeout) | only whole frames reach the board, in order: the core owns a frame's bytes until the UART has taken the last one, and any later call finishes a cut frame before its own | the next call, `poll` included | `cancellation::every_async_call_cut_at_every_await_point_leaves_only_whole_frames_and_a_working_driver` (every call, every await point) |
+//! | **a write cut by a transport error** | as a cancelled call: the rest of the frame stays in the core, the error is returned, the next call finishes the frame | the next call | `cancellation::every_blocking_call_cut_by_a_transport_error_after_every_byte_leaves_only_whole_frames` (every call, every byte) |
+//! | **a turn sent twice** | refused: [`CoreError::TurnInProgress`] until the pending angle reads within [`Config::turn_done_deci_degrees`] of 0; a new driver (a new [`DriverCore`]) reads the pending angle before its first turn, so a turn an earlier program or driver left running is found | — | `driver::a_turn_in_a_periodic_loop_is_sent_once`, `driver_edges::case5_the_turn_guard_survives_release_and_a_new_driver` |
+//! | **a late reply** | never answers a later read: an unanswered read leaves a ghost, a read of the same register waits until the ghost's reply has come or [`Config::late_reply_ms`] has passed, a late reply of another register is passed over; a timeout, or a late reply, makes later reads wait longer (at most [`Config::late_reply_ms`] more) | one failed read per slow board | `driver_edges::case3_a_board_slower_than_the_timeout_fails_one_read_not_every_read`, `driver_edges::case3_a_stale_zero_never_releases_the_turn_guard` |
+//! | **the clock wraps or goes back** | time is the core's own, from the differences of the clock's low 32 bits: a `u32` millisecond counter that wraps after 49.7 days is one more millisecond; a clock that goes back stands still until it is past where it was | — | `driver_edges::case4_*`, unit tests in `driver/time.rs` |
+//! | **the clock stands still** | a request gives up with [`CoreError::ClockStalled`] after [`blocking::STALL_POLLS`] polls ([`asynch::STALL_WAITS`](asynch) waits) that saw the clock stand still, whatever bytes arrive; a `poll` reads at most [`blocking::POLL_READS`] buffers | 1 000 000 polls (10 000 async waits) | `driver_edges::case2_*` |
+//! | **the driver released, rebuilt or reconfigured** | [`blocking::Driver::release`] gives back the [`DriverCore`] (the turn guard, bytes read, a frame half sent); [`blocking::Driver::from_core`] goes on from it; [`blocking::Driver::set_config`] changes the limits in place | nothing lost | `driver_edges::case5_*` |
+//! | **the driver dropped** | nothing: no I/O happens in `Drop`, and the 2020 board has no watchdog of its own, so the chassis keeps its last command. **Call `stop()` before you drop a driver that moved the chassis**; the `chassis` command does it on every signal | — | — |
+//!
+//! A [`Turn`](crate::Turn) is `Clone`: a clone is a second turn asked for on purpose, and the
+//! driver refuses it while the first is outstanding (`driver_edges::case5_a_cloned_turn_is_refused_while_the_first_runs`).
+//!
+//! The wire-independent part of this policy (the frame slot, the failsafe, time, the stall
+//! bounds) is written once, generic over the wire format (`driver/safety.rs`).
+//!
 //! # The failsafe, in one sentence
 //!
 //! While the driver has the chassis moving, it sends STOP once no frame from the board
-//! (telemetry or reply) has been read for [`Config::failsafe_ms`] (100 ms), or, after a settings
-//! frame, for [`Config::settings_pause_ms`] (600 ms: the board pauses telemetry while settings
-//! are made, A13) until its telemetry is back. It is judged only after every byte the UART holds has been read, so a loop
-//! slower than the limit is never stopped by its own slowness; such a loop stops a silent board
-//! at its first poll that reads nothing.
+//! (telemetry or reply) has been read for [`Config::failsafe_ms`] (100 ms; 200 ms with
+//! [`Config::HOST`]), or, after a settings frame, for [`Config::settings_pause_ms`] (600 ms:
+//! the board pauses telemetry while settings are made, A13) until its telemetry is back. It is
+//! judged only after every byte the UART holds has been read, so a loop slower than the limit
+//! is never stopped by its own slowness; such a loop stops a silent board at its first poll
+//! that reads nothing.
 //!
 //! # The angle hazard, and how the driver takes it away
 //!
@@ -75,14 +103,22 @@
 //! critical_section::with(|cs| {
 //!     let mut core = CORE.borrow_ref_mut(cs);
 //!     while core.tick(now_ms()).is_some() {}                      // quiet line, timeouts, failsafe
-//!     while let Some(frame) = core.transmit(now_ms()) { uart_tx.write_all(&frame) }
+//!     // The core keeps each frame until the UART has taken its last byte.
+//!     while let Some(bytes) = core.transmit(now_ms()) {
+//!         let n = uart_tx.write(bytes)?;
+//!         core.transmitted(n, now_ms());
+//!     }
 //! });
 //! ```
 //!
 //! # Time
 //!
-//! Time is milliseconds from any origin, as a `u64`; it must not go back. The shells read it
-//! from a [`Clock`].
+//! Time is milliseconds from any origin, read from a [`Clock`] (the shells) or passed to each
+//! [`DriverCore`] call. The core keeps its own monotonic time from the differences between
+//! readings, taken on their low 32 bits: a `u64` clock runs as it is (the core's times equal its
+//! readings), a `u32` tick counter may be handed over as it is (`|| millis() as u64`) and wrap,
+//! and a clock that goes back makes time stand still until it is past where it was. Two
+//! readings more than 24.8 days apart with no call in between are not supported.
 
 #[cfg(feature = "async")]
 pub mod asynch;
@@ -128,7 +164,7 @@ pub struct Config {
     /// How long the board may take to answer a read, beyond the bytes' time on the wire, in ms.
     pub board_latency_ms: u32,
     /// While moving, the board silent (no frame of any kind) for longer than this: the driver
-    /// sends stop.
+    /// sends stop (100 ms; 200 ms with [`Config::HOST`]).
     pub failsafe_ms: u32,
     /// After a settings frame the board pauses its telemetry (A13: at least up to 500 ms); the
     /// failsafe allows it this long to speak again.
@@ -176,7 +212,8 @@ impl Config {
     /// How long to wait for a reply: the request (10 bytes), a telemetry frame that may be on
     /// the wire first (15) and the reply (6), at 10 bits a byte, rounded up; the board's
     /// latency; and [`idle_ms`](Config::idle_ms), since a reply alone on a quiet line is
-    /// proved by the quiet. 55 ms with [`Config::DEFAULT`].
+    /// proved by the quiet. 55 ms with [`Config::DEFAULT`], 133 ms with [`Config::HOST`]. A
+    /// board found slower waits longer ([`DriverCore::reply_timeout_ms`]).
     #[must_use]
     pub const fn reply_timeout_ms(&self) -> u32 {
         const BITS: u64 = (10 + 15 + 6) * 10;

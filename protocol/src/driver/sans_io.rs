@@ -840,7 +840,8 @@ impl DriverCore {
     }
 
     /// How long a read waits for its reply now: [`Config::reply_timeout_ms`], or longer once
-    /// a late reply has shown the board to be slower (at most [`Config::late_reply_ms`] more).
+    /// a timeout or a late reply has shown the board to be slower (at most
+    /// [`Config::late_reply_ms`] more); replies in time bring it back.
     #[must_use]
     pub fn reply_timeout_ms(&self) -> u64 {
         let base = u64::from(self.config.reply_timeout_ms());
@@ -1292,6 +1293,12 @@ mod tests {
     #[test]
     fn reply_timeout_follows_the_baud_rate() {
         assert_eq!(Config::DEFAULT.reply_timeout_ms(), 3 + 50 + 2);
+        assert_eq!(
+            Config::HOST.reply_timeout_ms(),
+            133,
+            "as the driver docs say"
+        );
+        assert_eq!(Config::HOST.failsafe_ms, 200, "as the driver docs say");
         let slow = Config {
             baud: 9_600,
             board_latency_ms: 0,
