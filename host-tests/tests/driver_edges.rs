@@ -88,6 +88,9 @@ fn case2_a_stuck_clock_ends_a_read_in_stated_polls_while_telemetry_flows() {
         assert!(d.core().imu().is_some(), "telemetry flowed meanwhile");
         // Each poll of the driver asks `read_ready` at least once: the bound is in polls.
         let polls = d.uart().polls;
+        eprintln!(
+            "stuck clock, {max_read}-byte reads: ClockStalled after {polls} read_ready calls"
+        );
         let bound = u64::from(blocking::STALL_POLLS) * (32 / max_read as u64 + 2);
         assert!(
             polls <= bound,
@@ -110,6 +113,10 @@ fn case2_a_stuck_clock_ends_an_async_read_while_telemetry_flows() {
     let result = embassy_futures::block_on(d.read(reg::MaxSpeed));
     assert_eq!(result, Err(Error::Core(CoreError::ClockStalled)));
     assert!(d.core().imu().is_some(), "telemetry flowed meanwhile");
+    eprintln!(
+        "stuck clock, async: ClockStalled after {} ms of delays",
+        time.get()
+    );
     // At most STALL_WAITS pump turns of at most MAX_WAIT_MS each.
     assert!(
         time.get() <= u64::from(asynch::STALL_WAITS) * asynch::MAX_WAIT_MS + 100,
@@ -189,6 +196,7 @@ fn case3_a_board_slower_than_the_timeout_fails_one_read_not_every_read() {
                 Err(e) => panic!("{register:?} at {delay} ms: {e:?}"),
             }
         }
+        eprintln!("board answering in {delay} ms: {timeouts} timeouts in 6 reads");
         // Before: at 60 ms one Timeout, then five WrongReply.
         assert!(timeouts <= 1, "{timeouts} timeouts at {delay} ms");
         // Before: at 120 ms, Unconfirmed.
@@ -274,6 +282,7 @@ fn case4_the_failsafe_stops_across_the_wrap() {
         );
     }
     let stopped_after = time.get() - silent_from;
+    eprintln!("silent across the wrap: stopped {stopped_after} ms after");
     assert!(stopped_after <= 130, "stopped {stopped_after} ms after");
     assert_eq!(d.core().failsafe_stops(), 1);
 }
@@ -405,11 +414,16 @@ fn case6_a_turn_outstanding_when_the_link_dies_is_cancelled_at_the_first_reply()
     assert!(d.core().turning(), "the guard holds while nothing is known");
     let pending = d.uart().board().pending_deci_degrees();
     assert!(pending > 0, "still turning: {pending}");
-    // stop() with its replies lost says the turn may still run, and keeps the guard.
+    // stop() with its replies lost says the turn may still run, and keeps the guard; it ends
+    // within its stated bound (four reads, each waited for and its late reply allowed for).
+    let asked = time.get();
     assert_eq!(
         d.stop(),
         Err(Error::Core(CoreError::Unconfirmed(Register::PendingAngle)))
     );
+    let took = time.get() - asked;
+    eprintln!("stop() with the replies lost: Unconfirmed after {took} ms");
+    assert!(took <= 4 * (205 + 150) + 50, "stop() took {took} ms");
     assert!(d.core().turning());
     // The link comes back: at the first reply, the rest of the turn is cancelled.
     d.uart_mut().board_mut().set_faults(Faults::default());
@@ -422,6 +436,10 @@ fn case6_a_turn_outstanding_when_the_link_dies_is_cancelled_at_the_first_reply()
         );
     }
     let cancelled_after = time.get() - back;
+    eprintln!(
+        "turn cancelled {cancelled_after} ms after the link came back; {} of 1800 turned",
+        d.uart().board().total_turn_commanded()
+    );
     assert!(
         cancelled_after <= 200,
         "cancelled {cancelled_after} ms after"
