@@ -333,7 +333,8 @@ fn prepare_blocking(d: &mut Blocking<'_>, call: Call, time: &Cell<u64>) {
 /// What the board received and what the driver did, judged.
 struct Verdict<'a> {
     call: Call,
-    cut: String,
+    /// The call and where it was cut, for the messages.
+    what: &'a str,
     wire: &'a [u8],
     /// Bytes on the wire before the call under test.
     before: usize,
@@ -343,9 +344,30 @@ struct Verdict<'a> {
     max_speed_read: u16,
 }
 
-impl Verdict<'_> {
+impl<'a> Verdict<'a> {
+    /// Judges what `uart`'s board received after `call` was cut and followed up.
+    fn judge(
+        call: Call,
+        what: &'a str,
+        uart: &'a Choppy<'_>,
+        before: usize,
+        turn_committed: bool,
+        max_speed_read: u16,
+    ) {
+        Verdict {
+            call,
+            what,
+            wire: &uart.wire,
+            before,
+            turn_committed,
+            board: uart.uart.board(),
+            max_speed_read,
+        }
+        .check();
+    }
+
     fn check(&self) {
-        let what = format!("{:?} cut {}", self.call, self.cut);
+        let what = self.what;
         let frames = frames(self.wire).unwrap_or_else(|e| panic!("{what}: {e}"));
         let count = |f: &Frame| frames.iter().filter(|(_, g)| g == f).count();
         // Only whole frames: the board executed one command per frame, none made of two.
@@ -444,17 +466,14 @@ fn every_async_call_cut_at_every_await_point_leaves_only_whole_frames_and_a_work
                 );
                 let what = format!("{call:?} after {polls} polls, {chunk}-byte writes");
                 let max_speed_read = follow_up_async(&mut d, &what);
-                let uart = d.uart();
-                Verdict {
+                Verdict::judge(
                     call,
-                    cut: format!("after {polls} polls, {chunk}-byte writes"),
-                    wire: &uart.wire,
+                    &what,
+                    d.uart(),
                     before,
                     turn_committed,
-                    board: uart.uart.board(),
                     max_speed_read,
-                }
-                .check();
+                );
                 cuts += 1;
                 if finished {
                     break;
@@ -496,17 +515,14 @@ fn every_blocking_call_cut_by_a_transport_error_after_every_byte_leaves_only_who
             while time.get() < until {
                 d.poll().unwrap();
             }
-            let uart = d.uart();
-            Verdict {
+            Verdict::judge(
                 call,
-                cut: format!("at byte {at}"),
-                wire: &uart.wire,
+                &what,
+                d.uart(),
                 before,
                 turn_committed,
-                board: uart.uart.board(),
                 max_speed_read,
-            }
-            .check();
+            );
             cuts += 1;
             if !cut {
                 break;
