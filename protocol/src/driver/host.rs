@@ -78,15 +78,18 @@ impl From<serialport::Error> for SerialError {
 }
 
 impl SerialPort {
-    /// Opens `path` at 115 200 bps, 8 data bits, no parity, 1 stop bit, no flow control.
+    /// Opens `path` at 115 200 bps, 8 data bits, no parity, 1 stop bit, no flow control, and
+    /// throws away what the OS buffered before (a board that talked while nobody listened
+    /// would otherwise hand over seconds of stale frames at once, all stamped now).
     pub fn open(path: &str) -> Result<Self, SerialError> {
-        let port = serialport::new(path, BAUD)
+        let mut port = serialport::new(path, BAUD)
             .data_bits(serialport::DataBits::Eight)
             .parity(serialport::Parity::None)
             .stop_bits(serialport::StopBits::One)
             .flow_control(serialport::FlowControl::None)
             .timeout(WAIT_FOR_BYTE)
             .open()?;
+        port.clear(serialport::ClearBuffer::Input)?;
         Ok(SerialPort { port, held: None })
     }
 

@@ -10,7 +10,8 @@ use std::time::{Duration, Instant};
 /// back (to inspect what it was told). `io`'s reads must time out (1 ms or so): each turn of
 /// the loop takes in what the master sent, moves the board's clock to the wall clock, and
 /// writes what the board has sent since. A read that times out or would block is no error; an
-/// end of stream ends the run.
+/// end of stream ends the run. Bytes the other end does not take (a write that times out or
+/// would block) are dropped, as on a line nobody listens to: the board serves until stopped.
 pub fn serve<T: Read + Write>(mut board: Board, mut io: T, stop: &AtomicBool) -> io::Result<Board> {
     let start = Instant::now();
     let offset = board.now_ms();
@@ -37,9 +38,90 @@ pub fn serve<T: Read + Write>(mut board: Board, mut io: T, stop: &AtomicBool) ->
             if n == 0 {
                 break;
             }
-            io.write_all(buf.get(..n).unwrap_or(&[]))?;
+            send(&mut io, buf.get(..n).unwrap_or(&[]))?;
         }
-        io.flush()?;
+        match io.flush() {
+            Err(e) if !nobody_reads(&e) => return Err(e),
+            _ => {}
+        }
     }
     Ok(board)
+}
+
+/// A write that times out or would block: the other end is not reading (a pseudo-terminal
+/// whose buffer is full while no program has it open).
+fn nobody_reads(e: &io::Error) -> bool {
+    matches!(
+        e.kind(),
+        io::ErrorKind::TimedOut | io::ErrorKind::WouldBlock
+    )
+}
+
+/// Writes `bytes` as a line does: what nobody reads is lost, not waited for (a board keeps
+/// talking whether or not anyone listens).
+fn send<T: Write>(io: &mut T, mut bytes: &[u8]) -> io::Result<()> {
+    while !bytes.is_empty() {
+        match io.write(bytes) {
+            Ok(0) => return Err(io::ErrorKind::WriteZero.into()),
+            Ok(n) => bytes = bytes.get(n..).unwrap_or(&[]),
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+            Err(e) if nobody_reads(&e) => return Ok(()),
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::command::{Register, Setting};
+    use crate::sim::SimConfig;
+
+    /// The master sends one read, then never reads: every write times out (a pseudo-terminal's
+    /// buffer full). After 300 turns of the loop it sets `stop`.
+    struct NobodyReads<'a> {
+        sent: bool,
+        turns: u32,
+        stop: &'a AtomicBool,
+    }
+
+    impl Read for NobodyReads<'_> {
+        fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+            self.turns += 1;
+            if self.turns > 300 {
+                self.stop.store(true, Ordering::Relaxed);
+            }
+            if !self.sent {
+                self.sent = true;
+                let frame = Setting::Read(Register::MaxSpeed).encode();
+                buf[..frame.len()].copy_from_slice(&frame);
+                return Ok(frame.len());
+            }
+            Err(io::ErrorKind::TimedOut.into())
+        }
+    }
+
+    impl Write for NobodyReads<'_> {
+        fn write(&mut self, _: &[u8]) -> io::Result<usize> {
+            Err(io::ErrorKind::TimedOut.into())
+        }
+        fn flush(&mut self) -> io::Result<()> {
+            Err(io::ErrorKind::TimedOut.into())
+        }
+    }
+
+    #[test]
+    fn a_board_nobody_reads_keeps_serving_until_stopped() {
+        let stop = AtomicBool::new(false);
+        let io = NobodyReads {
+            sent: false,
+            turns: 0,
+            stop: &stop,
+        };
+        let board = serve(Board::new(SimConfig::default()), io, &stop)
+            .expect("writes nobody takes are dropped, not an error");
+        assert_eq!(board.commands(), 1, "the master's read was taken in");
+        assert!(stop.load(Ordering::Relaxed), "it ran until stopped");
+    }
 }
