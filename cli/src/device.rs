@@ -1,40 +1,69 @@
 //! The commands that talk to a board over a serial port (115 200 8N1), through the driver's
-//! host transport: get, set, settings, save, calibrate-gyro, drive, turn.
+//! host transport: get, set, settings, save, calibrate-gyro, stop, drive, turn.
+//!
+//! Every command that moves the chassis stops it on its way out, whatever ends it: done, an
+//! error, a board gone quiet, or SIGINT / SIGTERM / SIGHUP ([`crate::signals`]); a turn in
+//! progress is cancelled (the angle still pending is read and the opposite turn sent).
 
 use crate::encode::write_of;
-use crate::names::RegisterName;
-use chassis_protocol::driver::host::{HostDriver, SerialError, open as open_port};
-use chassis_protocol::driver::{CoreError, Error, Outcome, Request};
-use chassis_protocol::{Action, Register, Snapshot, SystemMode, Velocity};
+use crate::names::{RegisterName, register_name};
+use crate::port::{self, Board};
+use crate::signals;
+use chassis_protocol::driver::host::SerialError;
+use chassis_protocol::driver::{CoreError, Error, Outcome, Request, TurnState};
+use chassis_protocol::{Action, Register, Snapshot, SystemMode, Velocity, Write};
 use std::time::{Duration, Instant};
 
 /// Opens the board's serial port with the host defaults.
-pub fn open(port: &str) -> Result<HostDriver, String> {
-    open_port(port).map_err(|e| format!("cannot open {port}: {}", e.0))
+pub fn open(port: &str) -> Result<Board, String> {
+    port::open(port, None)
 }
 
-/// A driver error as one line.
-pub fn explain(e: Error<SerialError>) -> String {
+/// A driver error as one line, in the CLI's words. "Is it powered?" only when nothing at all
+/// came from the board.
+pub fn explain(driver: &Board, e: Error<SerialError>) -> String {
+    let port = driver.uart().name();
+    let silent = driver.core().last_heard_ms().is_none();
+    let nothing = |what: String| {
+        format!(
+            "nothing came from the board on {port}: {what} (is it powered, TX wired to RX and RX to TX, at 115200 bps?)"
+        )
+    };
     match e {
-        Error::Core(CoreError::Timeout(register))
-        | Error::Core(CoreError::Unconfirmed(register)) => {
-            format!(
-                "the board did not answer the read of {register:?} (is it powered, on this port, at 115200 bps?)"
-            )
+        Error::Core(CoreError::Timeout(r) | CoreError::Unconfirmed(r)) if silent => {
+            nothing(format!("no answer to the read of {}", register_name(r)))
         }
-        Error::Transport(e) => format!("serial port: {}", e.0),
+        Error::Core(CoreError::Timeout(r)) => format!(
+            "the board did not answer the read of {} (its telemetry arrives: a reply lost on the line?)",
+            register_name(r)
+        ),
+        Error::Core(CoreError::Unconfirmed(r)) => format!(
+            "the read of {} was not confirmed: its replies went missing or disagreed, while its telemetry arrives (a noisy line?)",
+            register_name(r)
+        ),
+        Error::Core(CoreError::WrongReply { expected, got }) => format!(
+            "a reply with code {got:#04x} came while reading {}",
+            register_name(expected)
+        ),
+        Error::Core(CoreError::Invalid { register, value }) => format!(
+            "a damaged reply: {value:#010x} cannot be {}'s value",
+            register_name(register)
+        ),
+        Error::Core(CoreError::TurnInProgress) => {
+            "the board still has a turn pending (it adds turns up): `chassis stop` cancels it"
+                .into()
+        }
+        Error::Transport(e) => format!("serial port {port}: {}", e.0),
         other => other.to_string(),
     }
 }
 
 /// Reads `register` until two replies agree; its raw value.
-pub fn read(driver: &mut HostDriver, register: Register) -> Result<u32, String> {
-    match driver
-        .run(Request::ReadVerified(register))
-        .map_err(explain)?
-    {
-        Outcome::Value(v) => Ok(v),
-        _ => Err(format!("no value for {register:?}")),
+pub fn read(driver: &mut Board, register: Register) -> Result<u32, String> {
+    match driver.run(Request::ReadVerified(register)) {
+        Ok(Outcome::Value(v)) => Ok(v),
+        Ok(_) => Err(format!("no value for {}", register_name(register))),
+        Err(e) => Err(explain(driver, e)),
     }
 }
 
@@ -71,23 +100,57 @@ pub fn get(port: &str, register: RegisterName) -> Result<(), String> {
     Ok(())
 }
 
-/// `chassis set REGISTER VALUE [CUTOFF]`: writes, then reads back.
+/// The instructions of a gyro calibration.
+const CALIBRATION: &str = "a gyro calibration takes 30 s: put the chassis down within 10 s, then do not move or touch it for 20 s";
+
+/// `chassis set REGISTER VALUE [CUTOFF]`: writes, then reads back. A write that starts a gyro
+/// calibration (gyro-calibration 0xFFFF; system-mode switching bit 3 on) needs `yes`.
 pub fn set(
     port: &str,
     register: RegisterName,
     value: &str,
     cutoff: Option<&str>,
+    yes: bool,
 ) -> Result<(), String> {
     let write = write_of(register, value, cutoff)?;
     let mut driver = open(port)?;
-    driver.write(write).map_err(explain)?;
-    let back = read(&mut driver, register.register())?;
+    let calibrates = match write {
+        Write::GyroCalibration(0xFFFF) => true,
+        Write::SystemMode(mode) if mode.gyro_compensation() => {
+            // Switching bit 3 on starts a calibration; already on, it does not.
+            match read(&mut driver, Register::SystemMode) {
+                Ok(now) => !SystemMode::from_bits(now).gyro_compensation(),
+                Err(e) => {
+                    return Err(format!(
+                        "{e}; nothing written (the mode could not be read to tell whether this write starts a gyro calibration)"
+                    ));
+                }
+            }
+        }
+        _ => false,
+    };
+    if calibrates && !yes {
+        return Err(format!(
+            "this write starts a gyro calibration ({CALIBRATION}); nothing written: add --yes to go ahead, or use `chassis calibrate-gyro`, which waits it out"
+        ));
+    }
+    driver.write(write).map_err(|e| explain(&driver, e))?;
+    if calibrates {
+        eprintln!("gyro calibration started: {CALIBRATION}");
+    }
+    let back = read(&mut driver, register.register()).map_err(|e| {
+        format!(
+            "{}: {} was written (the frame went out) but not confirmed: {e}",
+            register.name(),
+            show(register.register(), write.value())
+        )
+    })?;
     if back != write.value() {
         return Err(format!(
-            "{} reads back {} after writing {}",
+            "{}: wrote {}, but it reads back {}",
             register.name(),
-            back,
-            write.value()
+            show(register.register(), write.value()),
+            show(register.register(), back)
         ));
     }
     println!(
@@ -98,6 +161,50 @@ pub fn set(
     Ok(())
 }
 
+/// What a restore of `file` wrote, in words: every register, the gyro-compensation bit as
+/// the board kept it, what was left out.
+fn restored(file: &str, wanted: &Snapshot, board: &Snapshot) -> String {
+    let mut lines = vec![format!(
+        "restored from {file}: max-speed {}, kp {}, ki {}, gyro-gain {}, motor-voltage {}, battery-range {}",
+        wanted.max_speed,
+        wanted.speed_kp,
+        wanted.speed_ki,
+        wanted.gyro_gain,
+        show(Register::MotorVoltage, u32::from(wanted.motor_centivolts)),
+        show(
+            Register::BatteryRange,
+            (u32::from(wanted.battery_full_centivolts) << 16)
+                | u32::from(wanted.battery_cutoff_centivolts)
+        ),
+    )];
+    let onoff = |on: bool| if on { "on" } else { "off" };
+    let (want, kept) = (
+        wanted.system_mode.gyro_compensation(),
+        board.system_mode.gyro_compensation(),
+    );
+    lines.push(format!(
+        "system-mode 0x{:08X}: all bits from the file{}",
+        board.system_mode.bits(),
+        if want == kept {
+            String::new()
+        } else {
+            format!(
+                " but bit 3 (gyro compensation), kept {} as the board had it (the file says {}; switching it on starts a 30 s calibration: `chassis set system-mode 0x{:X} --yes`)",
+                onoff(kept),
+                onoff(want),
+                wanted.system_mode.bits()
+            )
+        }
+    ));
+    lines.push(format!(
+        "not restored: gyro-calibration (the file says {}, the board keeps {}: a calibration value belongs to one board and one place; `chassis calibrate-gyro` makes a new one)",
+        wanted.gyro_calibration, board.gyro_calibration
+    ));
+    lines
+        .push("not stored in the board's flash: `chassis save` keeps it over a power cycle".into());
+    lines.join("\n")
+}
+
 /// `chassis settings [--save FILE | --restore FILE]`.
 pub fn settings(port: &str, save: Option<&str>, restore: Option<&str>) -> Result<(), String> {
     if let Some(file) = restore {
@@ -105,17 +212,46 @@ pub fn settings(port: &str, save: Option<&str>, restore: Option<&str>) -> Result
         let snapshot: Snapshot =
             serde_json::from_str(&text).map_err(|e| format!("{file}: not a settings file: {e}"))?;
         let mut driver = open(port)?;
-        driver.restore_settings(&snapshot).map_err(explain)?;
-        eprintln!("restored from {file} (not saved to the board's flash: `chassis save`)");
+        driver
+            .restore_settings(&snapshot)
+            .map_err(|e| explain(&driver, e))?;
+        let board = driver.read_settings().map_err(|e| {
+            format!(
+                "{file}: written, but not read back: {}",
+                explain(&driver, e)
+            )
+        })?;
+        let expected = Snapshot {
+            system_mode: snapshot
+                .system_mode
+                .with_gyro_compensation(board.system_mode.gyro_compensation()),
+            gyro_calibration: board.gyro_calibration,
+            ..snapshot
+        };
+        if board != expected {
+            return Err(format!(
+                "{file}: written, but the board reads back other settings: {}",
+                serde_json::to_string(&board).unwrap_or_default()
+            ));
+        }
+        eprintln!("{}", restored(file, &snapshot, &board));
         return Ok(());
     }
+    // A file that cannot be written fails before the board is asked anything.
+    let mut out = match save {
+        Some(file) => Some((
+            file,
+            std::fs::File::create(file).map_err(|e| format!("cannot write {file}: {e}"))?,
+        )),
+        None => None,
+    };
     let mut driver = open(port)?;
-    let snapshot = driver.read_settings().map_err(explain)?;
+    let snapshot = driver.read_settings().map_err(|e| explain(&driver, e))?;
     let json = serde_json::to_string_pretty(&snapshot).map_err(|e| e.to_string())?;
-    match save {
-        Some(file) => {
-            std::fs::write(file, format!("{json}\n"))
-                .map_err(|e| format!("cannot write {file}: {e}"))?;
+    match out.as_mut() {
+        Some((file, f)) => {
+            use std::io::Write as _;
+            writeln!(f, "{json}").map_err(|e| format!("cannot write {file}: {e}"))?;
             eprintln!("saved to {file}");
         }
         None => println!("{json}"),
@@ -126,15 +262,30 @@ pub fn settings(port: &str, save: Option<&str>, restore: Option<&str>) -> Result
 /// `chassis save`: the current settings to the board's flash.
 pub fn save(port: &str) -> Result<(), String> {
     let mut driver = open(port)?;
-    driver.action(Action::Store).map_err(explain)?;
+    driver
+        .action(Action::Store)
+        .map_err(|e| explain(&driver, e))?;
     println!("settings stored in the board's flash");
+    Ok(())
+}
+
+/// Polls the driver for `ms`, or until a signal comes.
+fn poll_for(driver: &mut Board, ms: u64) -> Result<(), String> {
+    let until = Instant::now() + Duration::from_millis(ms);
+    while Instant::now() < until && signals::caught().is_none() {
+        if driver.poll().map_err(|e| explain(driver, e))?.is_none() {
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
     Ok(())
 }
 
 /// `chassis calibrate-gyro`: 30 s; the chassis must stay still.
 pub fn calibrate_gyro(port: &str) -> Result<(), String> {
     let mut driver = open(port)?;
-    driver.action(Action::RecalibrateGyro).map_err(explain)?;
+    driver
+        .action(Action::RecalibrateGyro)
+        .map_err(|e| explain(&driver, e))?;
     eprintln!(
         "gyro calibration started (30 s): put the chassis down now; from 10 s on, do not move or touch it"
     );
@@ -146,7 +297,7 @@ pub fn calibrate_gyro(port: &str) -> Result<(), String> {
     let start = Instant::now();
     let total = Duration::from_secs(30);
     while start.elapsed() < total {
-        let _ = driver.poll().map_err(explain)?;
+        poll_for(&mut driver, 50)?;
         let s = start.elapsed().as_secs();
         bar.set_position(s);
         bar.set_message(if s < 10 {
@@ -154,7 +305,6 @@ pub fn calibrate_gyro(port: &str) -> Result<(), String> {
         } else {
             "keep still: do not touch"
         });
-        std::thread::sleep(Duration::from_millis(5));
     }
     bar.finish_and_clear();
     let value = read(&mut driver, Register::GyroCalibration)?;
@@ -162,33 +312,111 @@ pub fn calibrate_gyro(port: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// Stops the chassis (cancelling a turn) and says how the command ended: `ended` is what
+/// happened, `Ok` a line for stdout.
+fn stop_after(driver: &mut Board, ended: Result<String, String>) -> Result<String, String> {
+    let stopped = driver.stop().map_err(|e| explain(driver, e));
+    if let Some(signal) = signals::caught() {
+        return Err(match stopped {
+            Ok(()) => format!(
+                "interrupted by {}: the chassis was stopped{}",
+                signals::name(signal),
+                ended.err().map(|e| format!(" ({e})")).unwrap_or_default()
+            ),
+            Err(e) => format!(
+                "interrupted by {}: the stop was sent but not confirmed: {e}",
+                signals::name(signal)
+            ),
+        });
+    }
+    match (ended, stopped) {
+        (Ok(line), Ok(())) => Ok(line),
+        (Err(e), Ok(())) => Err(format!("{e}; the chassis was stopped")),
+        (Ok(_), Err(e)) => Err(format!("the stop was sent but not confirmed: {e}")),
+        (Err(e), Err(s)) => Err(format!("{e}; the stop was sent but not confirmed: {s}")),
+    }
+}
+
+/// A progress bar on stderr (drawn only on a terminal).
+fn progress(len: u64, template: &str) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::with_draw_target(
+        Some(len),
+        indicatif::ProgressDrawTarget::stderr_with_hz(10),
+    );
+    if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// `chassis stop`: stops the chassis and cancels a turn the board still has pending (left by
+/// a program that was killed, say).
+pub fn stop(port: &str) -> Result<(), String> {
+    let mut driver = open(port)?;
+    let pending = driver.turn_remaining();
+    let stopped = driver.stop().map_err(|e| explain(&driver, e));
+    match (pending, stopped) {
+        (Ok(left), Ok(())) if driver.core().turn_state() == TurnState::Idle => {
+            if left.unsigned_abs() > 5 {
+                println!(
+                    "stopped; the {:.1}° turn the board had pending was cancelled",
+                    f64::from(left) / 10.0
+                );
+            } else {
+                println!("stopped (no turn was pending)");
+            }
+            Ok(())
+        }
+        (Ok(_), Ok(())) => {
+            Err("the stop was sent, but the turn pending could not be cancelled: try again".into())
+        }
+        (Err(e), Ok(())) => Err(format!(
+            "the stop was sent, but whether a turn is pending is not known: {}",
+            explain(&driver, e)
+        )),
+        (_, Err(e)) => Err(format!("the stop was sent but not confirmed: {e}")),
+    }
+}
+
 /// `chassis drive`: a velocity for a while, re-sent every 50 ms, then stop.
 pub fn drive(port: &str, velocity: Velocity, seconds: f64) -> Result<(), String> {
     if !(0.0..=600.0).contains(&seconds) {
         return Err(format!("--for: {seconds} s is out of range (0..=600)"));
     }
+    signals::install()?;
     let mut driver = open(port)?;
-    let end = Instant::now() + Duration::from_secs_f64(seconds);
-    let mut next = Instant::now();
-    let result = (|| -> Result<(), String> {
+    let start = Instant::now();
+    let end = start + Duration::from_secs_f64(seconds);
+    let bar = progress(
+        (seconds * 10.0).round() as u64,
+        "driving {bar:30} {msg} (Ctrl-C stops)",
+    );
+    let ended = (|| -> Result<String, String> {
+        let mut next = Instant::now();
         while Instant::now() < end {
+            if signals::caught().is_some() {
+                return Err("the drive was cut short".into());
+            }
             if Instant::now() >= next {
-                driver.set_velocity(velocity).map_err(explain)?;
+                driver
+                    .set_velocity(velocity)
+                    .map_err(|e| explain(&driver, e))?;
                 next += Duration::from_millis(50);
             }
-            let _ = driver.poll().map_err(explain)?;
+            poll_for(&mut driver, 5)?;
             if driver.core().failsafe_stops() > 0 {
-                return Err("the board went quiet: the driver stopped the chassis".into());
+                return Err(
+                    "the board went quiet while driving: the driver's failsafe stopped it".into(),
+                );
             }
-            std::thread::sleep(Duration::from_millis(2));
+            let done = start.elapsed().as_secs_f64().min(seconds);
+            bar.set_position((done * 10.0) as u64);
+            bar.set_message(format!("{done:.1}/{seconds} s"));
         }
-        Ok(())
+        Ok(format!("drove {seconds} s, stopped"))
     })();
-    // Stop whatever happened.
-    let stopped = driver.stop().map_err(explain);
-    result?;
-    stopped?;
-    println!("drove {seconds} s, stopped");
+    bar.finish_and_clear();
+    println!("{}", stop_after(&mut driver, ended)?);
     Ok(())
 }
 
@@ -198,31 +426,94 @@ pub fn turn(port: &str, degrees: f64) -> Result<(), String> {
         return Err(format!("{degrees}° is out of range (±6553.5)"));
     }
     let deci = (degrees * 10.0).round() as i32;
+    if deci == 0 {
+        return Err(format!(
+            "{degrees}° rounds to 0.0° (the board turns in steps of 0.1°): nothing sent"
+        ));
+    }
+    let shown = f64::from(deci) / 10.0;
+    signals::install()?;
     let mut driver = open(port)?;
-    driver.turn_by(deci).map_err(explain)?;
-    // At 90°/s on the simulated board; a real one may be slower: allow twice, and 5 s.
-    let limit = Duration::from_secs_f64(degrees.abs() / 45.0 + 5.0);
-    let start = Instant::now();
-    while driver.core().turning() {
-        if start.elapsed() > limit {
-            let left = driver.turn_remaining().map_err(explain)?;
-            let _ = driver.stop();
+    match driver.turn_by(deci) {
+        Ok(()) => {}
+        Err(Error::Core(CoreError::TurnInProgress)) => {
+            let left = match driver.core().turn_state() {
+                TurnState::Turning { deci_degrees } => f64::from(deci_degrees) / 10.0,
+                _ => 0.0,
+            };
             return Err(format!(
-                "the turn was not done after {:.0} s ({:.1}° left); stopped",
-                limit.as_secs_f64(),
+                "the board still has {left:.1}° of an earlier turn pending (it adds turns up): not sent; wait for it to end, or `chassis stop` cancels it"
+            ));
+        }
+        Err(e) if driver.core().turn_state() == TurnState::Unknown => {
+            return Err(format!(
+                "the turn was not sent: whether the board has one pending is not known: {}",
+                explain(&driver, e)
+            ));
+        }
+        Err(e) => {
+            let e = explain(&driver, e);
+            return Err(
+                stop_after(&mut driver, Err(format!("the turn may have gone out: {e}")))
+                    .err()
+                    .unwrap_or(e),
+            );
+        }
+    }
+    // At 90°/s on the simulated board; a real one may be slower: allow twice, and 5 s.
+    let limit = Duration::from_secs_f64(shown.abs() / 45.0 + 5.0);
+    let start = Instant::now();
+    let bar = progress(
+        u64::from(deci.unsigned_abs()),
+        "turning {bar:30} {msg} (Ctrl-C cancels)",
+    );
+    let mut left = deci;
+    let mut unanswered = 0u32;
+    let ended = loop {
+        bar.set_position(u64::from(deci.abs_diff(left)));
+        bar.set_message(format!(
+            "{:.1}° of {shown:.1}°",
+            f64::from(deci - left) / 10.0
+        ));
+        if !driver.core().turning() {
+            break Ok(format!(
+                "turned {shown:.1}° in {:.1} s",
+                start.elapsed().as_secs_f64()
+            ));
+        }
+        if signals::caught().is_some() {
+            break Err(format!(
+                "the {shown:.1}° turn was sent and cancelled with {:.1}° left",
                 f64::from(left) / 10.0
             ));
         }
-        let until = Instant::now() + Duration::from_millis(100);
-        while Instant::now() < until {
-            let _ = driver.poll().map_err(explain)?;
-            std::thread::sleep(Duration::from_millis(2));
+        if driver.core().failsafe_stops() > 0 {
+            break Err(format!(
+                "the board went quiet during the {shown:.1}° turn (it was sent): the driver's failsafe stopped it"
+            ));
         }
-        let _ = driver.turn_remaining().map_err(explain)?;
-    }
-    println!(
-        "turned {degrees}° in {:.1} s",
-        start.elapsed().as_secs_f64()
-    );
+        if start.elapsed() > limit {
+            break Err(format!(
+                "the {shown:.1}° turn (sent) was not done after {:.0} s ({:.1}° left{})",
+                limit.as_secs_f64(),
+                f64::from(left) / 10.0,
+                if unanswered > 0 {
+                    format!(", {unanswered} reads of the pending angle unanswered")
+                } else {
+                    String::new()
+                }
+            ));
+        }
+        if let Err(e) = poll_for(&mut driver, 100) {
+            break Err(format!("the {shown:.1}° turn was sent: {e}"));
+        }
+        match driver.turn_remaining() {
+            Ok(l) => left = l,
+            // One read lost is no reason to give up: the limit above bounds the wait.
+            Err(_) => unanswered += 1,
+        }
+    };
+    bar.finish_and_clear();
+    println!("{}", stop_after(&mut driver, ended)?);
     Ok(())
 }

@@ -8,6 +8,9 @@ mod device;
 mod encode;
 mod monitor;
 mod names;
+mod port;
+mod record;
+mod signals;
 mod sim;
 mod value;
 
@@ -23,6 +26,10 @@ struct Cli {
     /// The board's serial port (115 200 8N1), for the commands that talk to a board.
     #[arg(long, global = true, value_name = "PATH")]
     port: Option<String>,
+    /// Record both directions of the command's traffic into FILE, time-stamped (read it back
+    /// with `chassis decode FILE --input saleae-csv --master-analyzer master`).
+    #[arg(long, global = true, value_name = "FILE")]
+    record: Option<String>,
     #[command(subcommand)]
     command: Cmd,
 }
@@ -71,9 +78,15 @@ enum Cmd {
         /// The register.
         register: RegisterName,
         /// The value (decimal or 0x hex).
+        #[arg(allow_hyphen_values = true)]
         value: String,
         /// battery-range only: the cut-off voltage.
+        #[arg(allow_hyphen_values = true)]
         cutoff: Option<String>,
+        /// Go ahead with a write that starts a 30 s gyro calibration (gyro-calibration 0xFFFF,
+        /// system-mode switching bit 3 on).
+        #[arg(long)]
+        yes: bool,
     },
     /// Every register as JSON; or save them to a file, or restore them from one.
     Settings {
@@ -88,7 +101,9 @@ enum Cmd {
     Save,
     /// Calibrate the gyro again (30 s: put the chassis down, then keep it still).
     CalibrateGyro,
-    /// Drive at a velocity for a while, then stop.
+    /// Stop the chassis, and cancel a turn the board still has pending.
+    Stop,
+    /// Drive at a velocity for a while, then stop (Ctrl-C stops at once).
     Drive {
         #[command(flatten)]
         axes: encode::Axes,
@@ -96,7 +111,8 @@ enum Cmd {
         #[arg(long = "for", value_name = "SECONDS")]
         seconds: f64,
     },
-    /// Turn by DEGREES (sent once: the board adds turns up) and wait until it is done.
+    /// Turn by DEGREES (sent once: the board adds turns up) and wait until it is done (Ctrl-C
+    /// cancels the turn).
     Turn {
         /// Degrees, positive or negative.
         #[arg(allow_hyphen_values = true)]
@@ -110,6 +126,16 @@ enum Cmd {
         /// The speed the keys drive at.
         #[arg(long, default_value = "300")]
         speed: String,
+    },
+    /// Capture what the board sends, time-stamped, into a file `chassis decode --input
+    /// saleae-csv` reads back (sends nothing; Ctrl-C ends it, the file complete).
+    Record {
+        /// The capture file to write.
+        #[arg(long, value_name = "FILE")]
+        out: String,
+        /// Stop after SECONDS (default: until Ctrl-C).
+        #[arg(long = "for", value_name = "SECONDS")]
+        seconds: Option<f64>,
     },
     /// Serve a simulated board (prints where).
     Sim {
@@ -134,7 +160,11 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
             eprintln!("chassis: {message}");
-            ExitCode::FAILURE
+            // A signal the command caught (and stopped the chassis for): 128 + its number, as
+            // a shell reports a process the signal ended.
+            signals::caught().map_or(ExitCode::FAILURE, |s| {
+                ExitCode::from(signals::exit_status(s))
+            })
         }
     }
 }
@@ -178,6 +208,14 @@ fn port(cli_port: Option<&str>) -> Result<&str, String> {
 
 fn run(cli: Cli) -> Result<(), String> {
     let p = cli.port.as_deref();
+    if let Some(file) = cli.record {
+        if matches!(cli.command, Cmd::Record { .. }) {
+            return Err(
+                "record: give the file with --out FILE (--record is for the other commands)".into(),
+            );
+        }
+        port::record_to(&file)?;
+    }
     match cli.command {
         Cmd::Decode {
             file,
@@ -225,12 +263,14 @@ fn run(cli: Cli) -> Result<(), String> {
             register,
             value,
             cutoff,
-        } => device::set(port(p)?, register, &value, cutoff.as_deref()),
+            yes,
+        } => device::set(port(p)?, register, &value, cutoff.as_deref(), yes),
         Cmd::Settings { save, restore } => {
             device::settings(port(p)?, save.as_deref(), restore.as_deref())
         }
         Cmd::Save => device::save(port(p)?),
         Cmd::CalibrateGyro => device::calibrate_gyro(port(p)?),
+        Cmd::Stop => device::stop(port(p)?),
         Cmd::Drive { axes, seconds } => {
             let (x, y, z) = axes.values()?;
             device::drive(port(p)?, chassis_protocol::Velocity::new(x, y, z), seconds)
@@ -240,6 +280,7 @@ fn run(cli: Cli) -> Result<(), String> {
             let speed = value::parse_i32(&speed, "speed", 1, 65_535)?;
             monitor::run(port(p)?, drive, speed)
         }
+        Cmd::Record { out, seconds } => record::record(port(p)?, &out, seconds),
         Cmd::Sim {
             pty,
             tcp,

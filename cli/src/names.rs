@@ -42,6 +42,23 @@ impl RegisterName {
         }
     }
 
+    /// The name of `register` on the command line (for messages).
+    pub fn of(register: Register) -> Option<RegisterName> {
+        [
+            RegisterName::MaxSpeed,
+            RegisterName::Kp,
+            RegisterName::Ki,
+            RegisterName::GyroGain,
+            RegisterName::SystemMode,
+            RegisterName::GyroCalibration,
+            RegisterName::MotorVoltage,
+            RegisterName::BatteryRange,
+            RegisterName::PendingAngle,
+        ]
+        .into_iter()
+        .find(|n| n.register() == register)
+    }
+
     /// Its name on the command line.
     pub fn name(self) -> &'static str {
         match self {
@@ -87,4 +104,12 @@ impl ActionName {
             ActionName::GyroRecalibrate => Action::RecalibrateGyro,
         }
     }
+}
+
+/// `register`'s name on the command line ("max-speed"), or its code.
+pub fn register_name(register: Register) -> String {
+    RegisterName::of(register).map_or_else(
+        || format!("register {:#04x}", register.code()),
+        |n| n.name().to_string(),
+    )
 }

@@ -82,7 +82,7 @@ impl SerialPort {
     /// throws away what the OS buffered before (a board that talked while nobody listened
     /// would otherwise hand over seconds of stale frames at once, all stamped now).
     pub fn open(path: &str) -> Result<Self, SerialError> {
-        let mut port = serialport::new(path, BAUD)
+        let port = serialport::new(path, BAUD)
             .data_bits(serialport::DataBits::Eight)
             .parity(serialport::Parity::None)
             .stop_bits(serialport::StopBits::One)

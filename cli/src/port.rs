@@ -1,0 +1,201 @@
+//! The board's serial port as the CLI opens it: refused clearly when the path is no serial
+//! port, and optionally recorded, both directions time-stamped, as a Saleae Logic 2 export
+//! (`chassis decode FILE --input saleae-csv`, `--master-analyzer master` for both sides).
+
+use chassis_protocol::driver::Config;
+use chassis_protocol::driver::blocking::Driver;
+use chassis_protocol::driver::host::{MonotonicClock, SerialError, SerialPort};
+use std::fs::File;
+use std::io::{BufWriter, Write as _};
+use std::time::Instant;
+
+/// A byte's time on the line at 115 200 bps (10 bits), in seconds.
+pub const BYTE_S: f64 = 10.0 / 115_200.0;
+
+/// The driver the CLI uses: the host driver over a [`Port`].
+pub type Board = Driver<Port, MonotonicClock>;
+
+/// The capture file of `--record`, if given.
+static RECORD: std::sync::Mutex<Option<Recorder>> = std::sync::Mutex::new(None);
+
+/// From now on, the next port opened records both ways into `path` (`--record FILE`): the file
+/// is made now, so a path that cannot be written fails before anything is sent.
+pub fn record_to(path: &str) -> Result<(), String> {
+    let recorder = Recorder::create(path)?;
+    if let Ok(mut slot) = RECORD.lock() {
+        *slot = Some(recorder);
+    }
+    Ok(())
+}
+
+/// Opens `path` as the board's port with the host defaults; `record`, if given (or set by
+/// [`record_to`]), gets every byte both ways.
+pub fn open(path: &str, record: Option<Recorder>) -> Result<Board, String> {
+    let record = record.or_else(|| RECORD.lock().ok().and_then(|mut r| r.take()));
+    if let Ok(meta) = std::fs::metadata(path) {
+        if meta.is_file() || meta.is_dir() {
+            return Err(format!(
+                "cannot open {path}: it is a {}, not a serial port (a USB-UART adapter is /dev/ttyUSB0 or /dev/ttyACM0, on Windows COM3)",
+                if meta.is_dir() { "folder" } else { "file" }
+            ));
+        }
+    }
+    let port = SerialPort::open(path).map_err(|e| format!("cannot open {path}: {}", e.0))?;
+    Ok(Driver::new(
+        Port {
+            port,
+            path: path.to_string(),
+            record,
+        },
+        MonotonicClock::new(),
+        Config::HOST,
+    ))
+}
+
+/// The host serial port, with an optional recording of its bytes.
+#[derive(Debug)]
+pub struct Port {
+    port: SerialPort,
+    path: String,
+    record: Option<Recorder>,
+}
+
+impl Port {
+    /// The path it was opened with.
+    pub fn name(&self) -> &str {
+        &self.path
+    }
+
+    /// The recording, if any.
+    pub fn recorder(&self) -> Option<&Recorder> {
+        self.record.as_ref()
+    }
+
+    /// Ends the recording (flushes the file): what it wrote, or the first error.
+    pub fn finish_recording(&mut self) -> Option<Result<Counts, String>> {
+        self.record.as_mut().map(Recorder::finish)
+    }
+}
+
+impl embedded_io::ErrorType for Port {
+    type Error = SerialError;
+}
+
+impl embedded_io::ReadReady for Port {
+    fn read_ready(&mut self) -> Result<bool, SerialError> {
+        self.port.read_ready()
+    }
+}
+
+impl embedded_io::Read for Port {
+    fn read(&mut self, buf: &mut [u8]) -> Result<usize, SerialError> {
+        let n = self.port.read(buf)?;
+        if let (Some(record), Some(bytes)) = (self.record.as_mut(), buf.get(..n)) {
+            record.board(bytes);
+        }
+        Ok(n)
+    }
+}
+
+impl embedded_io::Write for Port {
+    fn write(&mut self, buf: &[u8]) -> Result<usize, SerialError> {
+        let n = self.port.write(buf)?;
+        if let (Some(record), Some(bytes)) = (self.record.as_mut(), buf.get(..n)) {
+            record.master(bytes);
+        }
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> Result<(), SerialError> {
+        self.port.flush()
+    }
+}
+
+/// Bytes and frames recorded so far.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counts {
+    /// Bytes from the board.
+    pub board_bytes: u64,
+    /// Bytes the master (this program) sent.
+    pub master_bytes: u64,
+}
+
+/// A capture file being written: `name,type,start_time,duration,data` rows, one per byte,
+/// `board` or `master`, times in seconds from the start.
+#[derive(Debug)]
+pub struct Recorder {
+    out: BufWriter<File>,
+    path: String,
+    start: Instant,
+    /// When the last byte of each side started, in s.
+    last: [f64; 2],
+    counts: Counts,
+    error: Option<String>,
+}
+
+impl Recorder {
+    /// Creates `path` (fails at once if it cannot be written) and writes the header.
+    pub fn create(path: &str) -> Result<Recorder, String> {
+        let file = File::create(path).map_err(|e| format!("cannot write {path}: {e}"))?;
+        let mut out = BufWriter::new(file);
+        writeln!(out, "name,type,start_time,duration,data")
+            .map_err(|e| format!("cannot write {path}: {e}"))?;
+        Ok(Recorder {
+            out,
+            path: path.to_string(),
+            start: Instant::now(),
+            last: [f64::NEG_INFINITY; 2],
+            counts: Counts::default(),
+            error: None,
+        })
+    }
+
+    /// What was recorded so far.
+    pub fn counts(&self) -> Counts {
+        self.counts
+    }
+
+    /// Bytes the board sent, just read: they came one after the other and ended about now.
+    fn board(&mut self, bytes: &[u8]) {
+        let now = self.start.elapsed().as_secs_f64();
+        let first = now - BYTE_S * bytes.len() as f64;
+        self.counts.board_bytes += bytes.len() as u64;
+        self.rows(0, first, bytes);
+    }
+
+    /// Bytes this program sent, just handed to the port: they leave from now on.
+    fn master(&mut self, bytes: &[u8]) {
+        let now = self.start.elapsed().as_secs_f64();
+        self.counts.master_bytes += bytes.len() as u64;
+        self.rows(1, now, bytes);
+    }
+
+    fn rows(&mut self, side: usize, first: f64, bytes: &[u8]) {
+        let name = if side == 0 { "board" } else { "master" };
+        let Some(last) = self.last.get_mut(side) else {
+            return;
+        };
+        let mut t = first.max(*last + BYTE_S).max(0.0);
+        for byte in bytes {
+            if self.error.is_none() {
+                if let Err(e) = writeln!(self.out, "{name},data,{t:.7},{BYTE_S:.7},0x{byte:02X}") {
+                    self.error = Some(format!("cannot write {}: {e}", self.path));
+                }
+            }
+            *last = t;
+            t += BYTE_S;
+        }
+    }
+
+    /// Flushes the file: the counts, or the first error writing it.
+    pub fn finish(&mut self) -> Result<Counts, String> {
+        if let Err(e) = self.out.flush() {
+            self.error
+                .get_or_insert(format!("cannot write {}: {e}", self.path));
+        }
+        match &self.error {
+            Some(e) => Err(e.clone()),
+            None => Ok(self.counts),
+        }
+    }
+}

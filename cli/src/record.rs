@@ -1,0 +1,75 @@
+//! `chassis record`: what the board sends, time-stamped, into a file `chassis decode` reads
+//! back exactly (a Saleae Logic 2 export: quiet lines are gaps in the time stamps). Sends
+//! nothing. Ends after `--for`, or on Ctrl-C (SIGINT, SIGTERM, SIGHUP) with the file complete.
+
+use crate::device::explain;
+use crate::port::{self, Recorder};
+use crate::signals;
+use chassis_protocol::driver::Event;
+use std::time::{Duration, Instant};
+
+/// `chassis record --out FILE [--for SECONDS]`.
+pub fn record(path: &str, out: &str, seconds: Option<f64>) -> Result<(), String> {
+    if let Some(s) = seconds {
+        if !(s > 0.0 && s <= 86_400.0) {
+            return Err(format!("--for: {s} s is out of range (0..=86400)"));
+        }
+    }
+    signals::install()?;
+    // The file first: a path that cannot be written fails before the port is touched.
+    let recorder = Recorder::create(out)?;
+    let mut driver = port::open(path, Some(recorder))?;
+    let bar = indicatif::ProgressBar::with_draw_target(
+        None,
+        indicatif::ProgressDrawTarget::stderr_with_hz(5),
+    );
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("{spinner} recording {msg} (Ctrl-C ends it)")
+    {
+        bar.set_style(style);
+    }
+    let start = Instant::now();
+    let end = seconds.map(|s| start + Duration::from_secs_f64(s));
+    let mut frames = 0u64;
+    let mut error = None;
+    while signals::caught().is_none() && end.is_none_or(|end| Instant::now() < end) {
+        match driver.poll() {
+            Ok(Some(Event::Telemetry(_) | Event::Reply(_) | Event::StrayReply(_))) => frames += 1,
+            Ok(None) => std::thread::sleep(Duration::from_millis(2)),
+            Err(e) => {
+                error = Some(explain(&driver, e));
+                break;
+            }
+        }
+        let bytes = driver
+            .uart()
+            .recorder()
+            .map_or(0, |r| r.counts().board_bytes);
+        bar.set_message(format!(
+            "{frames} frames, {bytes} bytes, {:.0} s",
+            start.elapsed().as_secs_f64()
+        ));
+    }
+    bar.finish_and_clear();
+    let counts = driver
+        .uart_mut()
+        .finish_recording()
+        .unwrap_or(Ok(port::Counts::default()))?;
+    let summary = format!(
+        "recorded {} bytes from the board ({frames} frames) in {:.1} s to {out}; read it back: chassis decode {out} --input saleae-csv",
+        counts.board_bytes,
+        start.elapsed().as_secs_f64()
+    );
+    match error {
+        Some(e) => Err(format!("{e} (what came before is in {out}: {summary})")),
+        None => {
+            if counts.board_bytes == 0 {
+                eprintln!(
+                    "chassis record: nothing came from the board (is it powered, TX wired to RX, at 115200 bps?)"
+                );
+            }
+            println!("{summary}");
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,343 @@
+//! `chassis` at its edges, through a real pseudo-terminal to a simulated board that records
+//! every byte it is sent: every signal stops a moving command and the board ends still; a
+//! turn is never sent on top of one pending; every message says what did and did not happen.
+
+#![cfg(unix)]
+
+mod harness;
+
+use chassis_protocol::sim::Motion;
+use chassis_protocol::{Command, Setting, Write as RegWrite};
+use harness::{TestBoard, assert_stopped, chassis, moves, signal, wait};
+use std::process::Output;
+use std::time::{Duration, Instant};
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// One line on stderr, non-zero exit, no panic; `needles` all in it.
+fn assert_error(out: &Output, needles: &[&str]) {
+    let e = stderr(out);
+    assert!(!out.status.success(), "fails: {e}");
+    assert!(!e.contains("panicked"), "{e}");
+    for n in needles {
+        assert!(e.contains(n), "{n:?} in {e:?}");
+    }
+}
+
+const SIGNALS: [(&str, i32); 3] = [("INT", 2), ("TERM", 15), ("HUP", 1)];
+
+#[test]
+fn every_signal_during_drive_stops_the_chassis() {
+    for (name, number) in SIGNALS {
+        let board = TestBoard::start();
+        let child = board.spawn(&["drive", "--y", "300", "--for", "20"]);
+        board.wait_for(
+            "y = 300",
+            |c| matches!(c, Command::Velocity(v) if v.y == 300),
+        );
+        std::thread::sleep(Duration::from_millis(300));
+        signal(&child, name);
+        let out = wait(child, 5);
+        assert_eq!(out.status.code(), Some(128 + number), "SIG{name}: {out:?}");
+        assert!(
+            stderr(&out).contains(&format!(
+                "interrupted by SIG{name}: the chassis was stopped"
+            )),
+            "{}",
+            stderr(&out)
+        );
+        let (board, heard) = board.finish();
+        assert_stopped(&board, &heard);
+        println!(
+            "drive, SIG{name}: exit {:?}, the board's motion {:?}",
+            out.status.code(),
+            board.motion()
+        );
+    }
+}
+
+#[test]
+fn every_signal_during_turn_cancels_the_turn_and_stops() {
+    for (name, number) in SIGNALS {
+        let board = TestBoard::start();
+        let child = board.spawn(&["turn", "360"]);
+        board.wait_for(
+            "the turn",
+            |c| matches!(c, Command::Turn(t) if t.deci_degrees == 3_600),
+        );
+        std::thread::sleep(Duration::from_millis(400));
+        signal(&child, name);
+        let out = wait(child, 5);
+        assert_eq!(out.status.code(), Some(128 + number), "SIG{name}: {out:?}");
+        let e = stderr(&out);
+        assert!(e.contains(&format!("interrupted by SIG{name}")), "{e}");
+        assert!(e.contains("turn was sent and cancelled"), "{e}");
+        let (board, heard) = board.finish();
+        assert_stopped(&board, &heard);
+        let turns: Vec<i32> = harness::commands(&heard)
+            .iter()
+            .filter_map(|c| match c {
+                Command::Turn(t) => Some(t.deci_degrees),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(turns.len(), 2, "the turn and its cancel: {turns:?}");
+        assert!(turns[1] < 0 && turns[1] > -3_600, "{turns:?}");
+        println!(
+            "turn 360, SIG{name} after 0.4 s: turns sent {turns:?}, left pending {} (0.1°)",
+            board.pending_deci_degrees()
+        );
+    }
+}
+
+#[test]
+fn a_turn_is_never_sent_on_top_of_one_pending() {
+    let board = TestBoard::start();
+    let child = board.spawn(&["turn", "360"]);
+    board.wait_for("the turn", |c| matches!(c, Command::Turn(_)));
+    std::thread::sleep(Duration::from_millis(400));
+    // SIGKILL cannot be caught: the board is left turning.
+    signal(&child, "KILL");
+    let _ = wait(child, 5);
+    let out = board.run(&["turn", "90"]);
+    assert_error(&out, &["still has", "pending", "not sent", "chassis stop"]);
+    // `chassis stop` cancels what the killed one left.
+    let out = board.run(&["stop"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let said = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(said.contains("was cancelled"), "{said}");
+    let (board, heard) = board.finish();
+    let turns: Vec<i32> = harness::commands(&heard)
+        .iter()
+        .filter_map(|c| match c {
+            Command::Turn(t) => Some(t.deci_degrees),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(turns.first(), Some(&3_600), "{turns:?}");
+    assert_eq!(
+        turns.len(),
+        2,
+        "the turn and the stop's cancel, never a second +900"
+    );
+    assert_stopped(&board, &heard);
+}
+
+#[test]
+fn a_turn_outlives_lost_replies_and_a_zero_turn_is_refused() {
+    let board = TestBoard::start();
+    // The first read (is a turn pending?) is answered; then two answers are lost.
+    let child = board.spawn(&["turn", "90"]);
+    board.wait_for("the turn", |c| matches!(c, Command::Turn(_)));
+    board.lose_pending_angle_replies(2);
+    let out = wait(child, 15);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("turned 90.0°"));
+
+    for tiny in ["0.04", "-0.04"] {
+        let before = board.heard().len();
+        let out = board.run(&["turn", tiny]);
+        assert_error(&out, &["rounds to 0.0°", "nothing sent"]);
+        assert_eq!(board.heard().len(), before, "nothing went to the board");
+    }
+    let (board, _) = board.finish();
+    assert_eq!(board.total_turn_commanded(), 900);
+}
+
+#[test]
+fn a_set_on_a_silent_board_says_the_write_went_out() {
+    let board = TestBoard::start();
+    board.go_silent(true);
+    let out = board.run(&["set", "max-speed", "800"]);
+    assert_error(
+        &out,
+        &[
+            "max-speed: 800 was written",
+            "not confirmed",
+            "nothing came from the board",
+        ],
+    );
+    let (board, _) = board.finish();
+    assert_eq!(board.registers().max_speed, 800, "the write was applied");
+}
+
+#[test]
+fn errors_name_registers_as_the_cli_does_and_hint_only_at_silence() {
+    let board = TestBoard::with(|b| b.set_faults(harness::no_replies()));
+    let out = board.run(&["get", "max-speed"]);
+    assert_error(&out, &["max-speed"]);
+    let e = stderr(&out);
+    assert!(!e.contains("MaxSpeed"), "{e}");
+    assert!(
+        !e.contains("powered"),
+        "telemetry arrives: no wiring hint: {e}"
+    );
+    assert!(e.contains("telemetry arrives"), "{e}");
+
+    let silent = TestBoard::start();
+    silent.go_silent(true);
+    let out = silent.run(&["get", "pending-angle"]);
+    assert_error(&out, &["pending-angle", "is it powered"]);
+    assert!(!stderr(&out).contains("PendingAngle"));
+}
+
+#[test]
+fn writes_that_start_a_calibration_need_yes() {
+    let board = TestBoard::start();
+    for args in [
+        &["set", "system-mode", "0x8"][..],
+        &["set", "gyro-calibration", "0xFFFF"][..],
+    ] {
+        let out = board.run(args);
+        assert_error(
+            &out,
+            &["starts a gyro calibration", "--yes", "nothing written"],
+        );
+    }
+    let out = board.run(&["set", "system-mode", "0x8", "--yes"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("gyro calibration started"));
+    // Already on: writing it again starts nothing, and needs no --yes.
+    let out = board.run(&["set", "system-mode", "0x18"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (board, heard) = board.finish();
+    assert!(board.calibrating(), "the --yes write started it");
+    let writes: Vec<_> = harness::commands(&heard)
+        .into_iter()
+        .filter_map(|c| match c {
+            Command::Setting(Setting::Write(w)) => Some(w),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        writes.len(),
+        2,
+        "only the --yes write and the 0x18 one: {writes:?}"
+    );
+    assert!(matches!(writes[0], RegWrite::SystemMode(m) if m.bits() == 0x8));
+}
+
+#[test]
+fn a_restore_says_what_it_did_not_restore() {
+    let board = TestBoard::start();
+    let file = std::env::temp_dir().join(format!("chassis-restore-{}.json", std::process::id()));
+    let file = file.to_string_lossy().into_owned();
+    let out = board.run(&["settings", "--save", &file]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let mut saved: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    saved["max_speed"] = 700.into();
+    saved["system_mode"] = 0x18.into();
+    saved["gyro_calibration"] = 0x1234.into();
+    std::fs::write(&file, saved.to_string()).unwrap();
+    let out = board.run(&["settings", "--restore", &file]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let e = stderr(&out);
+    for needle in [
+        "max-speed 700",
+        "bit 3 (gyro compensation), kept off",
+        "the file says on",
+        "not restored: gyro-calibration (the file says 4660",
+        "chassis save",
+    ] {
+        assert!(e.contains(needle), "{needle:?} in {e}");
+    }
+    let _ = std::fs::remove_file(&file);
+    let (board, _) = board.finish();
+    assert_eq!(board.registers().max_speed, 700);
+    assert!(!board.calibrating(), "a restore never starts a calibration");
+}
+
+#[test]
+fn bad_arguments_fail_before_the_board_is_asked() {
+    let board = TestBoard::start();
+    let out = board.run(&["set", "max-speed", "-1"]);
+    assert_error(&out, &["out of range"]);
+    let out = board.run(&["settings", "--save", "/nonexistent-folder/settings.json"]);
+    assert_error(&out, &["cannot write /nonexistent-folder/settings.json"]);
+    assert!(board.heard().is_empty(), "no register was read");
+
+    let file = std::env::temp_dir().join(format!("chassis-not-a-port-{}", std::process::id()));
+    std::fs::write(&file, "").unwrap();
+    let path = file.to_string_lossy().into_owned();
+    let out = chassis(&["--port", &path, "get", "max-speed"]);
+    assert_error(&out, &["is a file, not a serial port"]);
+    assert!(!stderr(&out).contains("typewriter"));
+    let _ = std::fs::remove_file(&file);
+
+    let out = board.run(&["monitor"]);
+    assert_error(&out, &["terminal"]);
+    assert!(!stderr(&out).contains("os error"), "{}", stderr(&out));
+}
+
+#[test]
+fn input_buffered_before_the_port_opens_is_not_read_as_new() {
+    let board = TestBoard::start();
+    // 2 s of telemetry wait in the pseudo-terminal with nobody reading.
+    std::thread::sleep(Duration::from_secs(2));
+    let dir = std::env::temp_dir().join(format!("chassis-stale-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("capture.csv").to_string_lossy().into_owned();
+    let out = board.run(&["record", "--out", &file, "--for", "0.5"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let rows = std::fs::read_to_string(&file).unwrap().lines().count() - 1;
+    // The board sends about 1.9 kB/s (IMU 100 Hz, encoders 25 Hz, battery 1 Hz): half a
+    // second is under 1 kB; the 2 s buffered would be 3.8 kB more.
+    println!("recorded {rows} bytes in 0.5 s after 2 s unread");
+    assert!(rows < 1_500, "{rows} bytes: stale input was read");
+    assert!(rows > 300, "{rows} bytes: the board was recorded");
+    let _ = std::fs::remove_dir_all(&dir);
+    drop(board);
+}
+
+#[test]
+fn the_simulated_board_serves_on_with_nobody_reading() {
+    // `chassis sim --pty`, nobody opens it for 14 s (its pseudo-terminal fills up in about
+    // 11 s), then a read is answered.
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_chassis"))
+        .args(["sim", "--pty"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    std::io::BufRead::read_line(
+        &mut std::io::BufReader::new(child.stdout.take().unwrap()),
+        &mut line,
+    )
+    .unwrap();
+    let start = Instant::now();
+    while start.elapsed() < Duration::from_secs(14) {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "chassis sim --pty ended by itself after {:?}",
+            start.elapsed()
+        );
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    let out = chassis(&["--port", line.trim(), "get", "max-speed"]);
+    let _ = child.kill();
+    let _ = child.wait();
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout).trim(),
+        "max-speed: 1000"
+    );
+}
+
+#[test]
+fn a_board_gone_quiet_mid_drive_is_stopped_and_said() {
+    let board = TestBoard::start();
+    let child = board.spawn(&["drive", "--y", "300", "--for", "10"]);
+    board.wait_for(
+        "y = 300",
+        |c| matches!(c, Command::Velocity(v) if v.y == 300),
+    );
+    board.go_silent(true);
+    let out = wait(child, 5);
+    assert_error(&out, &["went quiet", "failsafe stopped it"]);
+    let (board, heard) = board.finish();
+    assert_eq!(board.motion(), Motion::Velocity { x: 0, y: 0, z: 0 });
+    assert!(harness::commands(&heard).last().is_some_and(|c| !moves(c)));
+}

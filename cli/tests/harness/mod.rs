@@ -1,0 +1,421 @@
+//! What the CLI's edge tests share: a simulated board on a real pseudo-terminal that records
+//! every byte it is sent and can go silent, a terminal for the commands that need one, and the
+//! spec's stop frame.
+
+#![allow(dead_code)]
+
+use chassis_protocol::sim::{Board, Faults, Motion, SimConfig, serve};
+use chassis_protocol::{Command, UplinkParser};
+use serialport::{SerialPort as _, TTYPort};
+use std::io::{self, Read, Write};
+use std::process::{Child, Command as Process, Output, Stdio};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// The stop frame, from the spec's table 1A: velocity mode, X = Y = Z = 0, no direction bits.
+pub const STOP: [u8; 10] = [0xFF, 0xFE, 0x01, 0, 0, 0, 0, 0, 0, 0];
+
+/// The board's end of the line: records what it reads, drops what it writes while silent,
+/// drops the next `drop_replies` replies of the pending angle (`23 20 …`).
+struct Tap {
+    inner: TTYPort,
+    heard: Arc<Mutex<Vec<u8>>>,
+    silent: Arc<AtomicBool>,
+    drop_replies: Arc<AtomicU32>,
+}
+
+impl Read for Tap {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.heard.lock().unwrap().extend_from_slice(&buf[..n]);
+        Ok(n)
+    }
+}
+
+impl Write for Tap {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        if self.silent.load(Ordering::SeqCst) {
+            return Ok(buf.len());
+        }
+        if self.drop_replies.load(Ordering::SeqCst) > 0 {
+            if let Some(at) = buf.windows(2).position(|w| w == [0x23, 0x20]) {
+                if at + 6 <= buf.len() {
+                    self.drop_replies.fetch_sub(1, Ordering::SeqCst);
+                    let mut kept = buf[..at].to_vec();
+                    kept.extend_from_slice(&buf[at + 6..]);
+                    self.inner.write_all(&kept)?;
+                    return Ok(buf.len());
+                }
+            }
+        }
+        self.inner.write(buf)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.inner.flush()
+    }
+}
+
+/// A simulated board served on a pseudo-terminal in a thread of the test.
+pub struct TestBoard {
+    /// The path the CLI opens.
+    pub path: String,
+    stop: Arc<AtomicBool>,
+    silent: Arc<AtomicBool>,
+    drop_replies: Arc<AtomicU32>,
+    heard: Arc<Mutex<Vec<u8>>>,
+    thread: Option<JoinHandle<io::Result<Board>>>,
+    _keep: TTYPort,
+}
+
+impl TestBoard {
+    /// A board with factory settings.
+    pub fn start() -> TestBoard {
+        TestBoard::with(|_| {})
+    }
+
+    /// A board `setup` prepared (faults, registers).
+    pub fn with(setup: impl FnOnce(&mut Board)) -> TestBoard {
+        let (mut board_end, path_end) = TTYPort::pair().expect("a pseudo-terminal");
+        board_end.set_timeout(Duration::from_millis(1)).unwrap();
+        let path = path_end.name().expect("its path");
+        let mut board = Board::new(SimConfig::default());
+        setup(&mut board);
+        let stop = Arc::new(AtomicBool::new(false));
+        let silent = Arc::new(AtomicBool::new(false));
+        let drop_replies = Arc::new(AtomicU32::new(0));
+        let heard = Arc::new(Mutex::new(Vec::new()));
+        let tap = Tap {
+            inner: board_end,
+            heard: Arc::clone(&heard),
+            silent: Arc::clone(&silent),
+            drop_replies: Arc::clone(&drop_replies),
+        };
+        let flag = Arc::clone(&stop);
+        let thread = std::thread::spawn(move || serve(board, tap, &flag));
+        TestBoard {
+            path,
+            stop,
+            silent,
+            drop_replies,
+            heard,
+            thread: Some(thread),
+            _keep: path_end,
+        }
+    }
+
+    /// The board stops sending (it still hears everything).
+    pub fn go_silent(&self, silent: bool) {
+        self.silent.store(silent, Ordering::SeqCst);
+    }
+
+    /// The next `n` replies to reads of the pending angle are lost on the line.
+    pub fn lose_pending_angle_replies(&self, n: u32) {
+        self.drop_replies.store(n, Ordering::SeqCst);
+    }
+
+    /// Every byte the board was sent so far.
+    pub fn heard(&self) -> Vec<u8> {
+        self.heard.lock().unwrap().clone()
+    }
+
+    /// The commands the board was sent so far.
+    pub fn commands(&self) -> Vec<Command> {
+        commands(&self.heard())
+    }
+
+    /// Waits (up to 5 s) until the board was sent a command `want` accepts.
+    pub fn wait_for(&self, what: &str, want: impl Fn(&Command) -> bool) {
+        let start = Instant::now();
+        while !self.commands().iter().any(&want) {
+            assert!(
+                start.elapsed() < Duration::from_secs(5),
+                "the board was never sent {what}: {:?}",
+                self.commands()
+            );
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    }
+
+    /// `chassis --port PATH args`, run to its end.
+    pub fn run(&self, args: &[&str]) -> Output {
+        let mut all = vec!["--port", self.path.as_str()];
+        all.extend_from_slice(args);
+        chassis(&all)
+    }
+
+    /// `chassis --port PATH args`, started.
+    pub fn spawn(&self, args: &[&str]) -> Child {
+        let mut all = vec!["--port", self.path.as_str()];
+        all.extend_from_slice(args);
+        Process::new(env!("CARGO_BIN_EXE_chassis"))
+            .args(&all)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    }
+
+    /// Stops serving: the board as it ends, and every byte it was sent.
+    pub fn finish(mut self) -> (Board, Vec<u8>) {
+        self.stop.store(true, Ordering::SeqCst);
+        let board = self
+            .thread
+            .take()
+            .unwrap()
+            .join()
+            .unwrap()
+            .expect("the board served to the end");
+        (board, self.heard())
+    }
+}
+
+impl Drop for TestBoard {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::SeqCst);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// The commands in `bytes`, in order.
+pub fn commands(bytes: &[u8]) -> Vec<Command> {
+    let mut parser = UplinkParser::new();
+    bytes.iter().filter_map(|b| parser.push(*b)).collect()
+}
+
+/// A command that sets the chassis moving.
+pub fn moves(c: &Command) -> bool {
+    match c {
+        Command::Velocity(v) => v.x != 0 || v.y != 0 || v.z != 0,
+        Command::Motors(m) => m.values.iter().any(|v| *v != 0),
+        Command::Turn(t) => t.deci_degrees != 0 || t.x != 0 || t.y != 0,
+        _ => false,
+    }
+}
+
+/// The board ended still: told to stand still, and (with a turn cancelled) nothing left to
+/// turn but what the cancel's read raced (a degree or two); the stop frame went out after
+/// the last frame that moved it.
+pub fn assert_stopped(board: &Board, heard: &[u8]) {
+    assert_eq!(
+        board.motion(),
+        Motion::Velocity { x: 0, y: 0, z: 0 },
+        "the board's last motion command stops it"
+    );
+    assert!(
+        board.pending_deci_degrees().abs() <= 20,
+        "no turn left pending: {} (0.1°)",
+        board.pending_deci_degrees()
+    );
+    let last_stop = heard
+        .windows(STOP.len())
+        .rposition(|w| w == STOP)
+        .expect("the stop frame, byte for byte");
+    let cmds = commands(heard);
+    let after_stop = commands(&heard[last_stop + STOP.len()..]);
+    assert!(
+        after_stop
+            .iter()
+            .all(|c| !matches!(c, Command::Velocity(_)) || !moves(c)),
+        "nothing drove it after the stop: {after_stop:?} (all: {cmds:?})"
+    );
+}
+
+/// `chassis args`, run to its end.
+pub fn chassis(args: &[&str]) -> Output {
+    Process::new(env!("CARGO_BIN_EXE_chassis"))
+        .args(args)
+        .stdin(Stdio::null())
+        .output()
+        .expect("the binary runs")
+}
+
+/// Sends `signal` ("INT", "TERM", "HUP", "KILL") to `child`.
+pub fn signal(child: &Child, signal: &str) {
+    let ok = Process::new("kill")
+        .args([format!("-{signal}"), child.id().to_string()])
+        .status()
+        .unwrap()
+        .success();
+    assert!(ok, "kill -{signal}");
+}
+
+/// Waits (up to `secs`) for `child` to end.
+pub fn wait(child: Child, secs: u64) -> Output {
+    let start = Instant::now();
+    let mut child = child;
+    loop {
+        if child.try_wait().unwrap().is_some() {
+            return child.wait_with_output().unwrap();
+        }
+        if start.elapsed() > Duration::from_secs(secs) {
+            let _ = child.kill();
+            let out = child.wait_with_output().unwrap();
+            panic!(
+                "did not end within {secs} s: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+/// A command run in a terminal of its own (a pseudo-terminal, 100 × 30): what it drew, and a
+/// keyboard.
+pub struct Terminal {
+    /// The command.
+    pub child: Child,
+    master: TTYPort,
+    screen: Arc<Mutex<Vec<u8>>>,
+    reader: Option<JoinHandle<()>>,
+    done: Arc<AtomicBool>,
+}
+
+impl Terminal {
+    /// Starts `chassis args` with its stdin, stdout and stderr on a new terminal.
+    pub fn spawn(args: &[&str]) -> Terminal {
+        let (master, slave) = TTYPort::pair().expect("a pseudo-terminal");
+        let path = slave.name().unwrap();
+        let open = || {
+            std::fs::OpenOptions::new()
+                .read(true)
+                .write(true)
+                .open(&path)
+                .unwrap()
+        };
+        let ok = Process::new("stty")
+            .args(["cols", "100", "rows", "30"])
+            .stdin(open())
+            .status()
+            .unwrap()
+            .success();
+        assert!(ok, "stty sets the terminal's size");
+        let child = Process::new(env!("CARGO_BIN_EXE_chassis"))
+            .args(args)
+            .stdin(open())
+            .stdout(open())
+            .stderr(open())
+            .spawn()
+            .unwrap();
+        drop(slave);
+        let screen = Arc::new(Mutex::new(Vec::new()));
+        let done = Arc::new(AtomicBool::new(false));
+        let mut reading = master.try_clone_native().unwrap();
+        reading.set_timeout(Duration::from_millis(20)).unwrap();
+        let (into, stop) = (Arc::clone(&screen), Arc::clone(&done));
+        let reader = std::thread::spawn(move || {
+            let mut buf = [0u8; 4096];
+            while !stop.load(Ordering::SeqCst) {
+                match reading.read(&mut buf) {
+                    Ok(n) if n > 0 => into.lock().unwrap().extend_from_slice(&buf[..n]),
+                    Ok(_) => {}
+                    Err(e) if e.kind() == io::ErrorKind::TimedOut => {}
+                    Err(_) => std::thread::sleep(Duration::from_millis(20)),
+                }
+            }
+        });
+        Terminal {
+            child,
+            master,
+            screen,
+            reader: Some(reader),
+            done,
+        }
+    }
+
+    /// The screen as it stands (a terminal emulator replays everything drawn).
+    pub fn text(&self) -> String {
+        let mut parser = vt100::Parser::new(30, 100, 0);
+        parser.process(&self.screen.lock().unwrap());
+        parser.screen().contents()
+    }
+
+    /// Everything written, escape sequences taken out (for a command that prints lines).
+    pub fn written(&self) -> String {
+        strip_escapes(&String::from_utf8_lossy(&self.screen.lock().unwrap()))
+    }
+
+    /// Waits (up to 5 s) until the screen shows `needle`.
+    pub fn wait_for_text(&self, needle: &str) {
+        let start = Instant::now();
+        loop {
+            let text = self.text();
+            if text.contains(needle) {
+                return;
+            }
+            assert!(
+                start.elapsed() < Duration::from_secs(5),
+                "{needle:?} never on the screen:\n{text}"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
+    /// Types `keys`.
+    pub fn press(&mut self, keys: &[u8]) {
+        self.master.write_all(keys).unwrap();
+        self.master.flush().unwrap();
+    }
+
+    /// Waits (up to `secs`) for the command to end: its exit status.
+    pub fn wait(&mut self, secs: u64) -> std::process::ExitStatus {
+        let start = Instant::now();
+        loop {
+            if let Some(status) = self.child.try_wait().unwrap() {
+                return status;
+            }
+            if start.elapsed() > Duration::from_secs(secs) {
+                let _ = self.child.kill();
+                panic!("did not end within {secs} s: {}", self.text());
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    }
+}
+
+impl Drop for Terminal {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        self.done.store(true, Ordering::SeqCst);
+        if let Some(r) = self.reader.take() {
+            let _ = r.join();
+        }
+    }
+}
+
+/// `text` without ANSI escape sequences (CSI `ESC [ … letter`, and `ESC x`).
+pub fn strip_escapes(text: &str) -> String {
+    let mut out = String::new();
+    let mut chars = text.chars().peekable();
+    while let Some(c) = chars.next() {
+        if c != '\u{1b}' {
+            out.push(c);
+            continue;
+        }
+        if chars.peek() == Some(&'[') {
+            chars.next();
+            for c in chars.by_ref() {
+                if c.is_ascii_alphabetic() || c == '~' {
+                    break;
+                }
+            }
+        } else {
+            chars.next();
+        }
+    }
+    out
+}
+
+/// Faults that stop the board's replies (telemetry keeps coming).
+pub fn no_replies() -> Faults {
+    Faults {
+        replies_stopped: true,
+        ..Faults::default()
+    }
+}
