@@ -41,6 +41,8 @@ pub struct Capture {
     pub bytes: Vec<u8>,
     /// Their time stamps in seconds, if the capture has them (as many as the bytes).
     pub times: Option<Vec<f64>>,
+    /// A gap longer than this, in seconds, is a quiet line ([`QUIET_GAP_S`] if not given).
+    pub quiet_s: Option<f64>,
 }
 
 /// Reads `data` as `input`.
@@ -48,9 +50,12 @@ pub fn read_capture(data: &[u8], input: Input) -> Result<Capture, String> {
     match input {
         Input::Raw => Ok(Capture {
             bytes: data.to_vec(),
-            times: None,
+            ..Capture::default()
         }),
-        Input::Hex => parse_hex(data).map(|bytes| Capture { bytes, times: None }),
+        Input::Hex => parse_hex(data).map(|bytes| Capture {
+            bytes,
+            ..Capture::default()
+        }),
         Input::SaleaeCsv => parse_saleae(data),
     }
 }
@@ -150,8 +155,8 @@ fn parse_saleae_rows(data: &[u8], keep: impl Fn(&[String]) -> bool) -> Result<Ca
     };
     let type_col = columns.iter().position(|c| c == "type");
     let mut capture = Capture {
-        bytes: Vec::new(),
         times: Some(Vec::new()),
+        ..Capture::default()
     };
     for (line_no, line) in lines {
         let fields = split_csv(line);
@@ -308,12 +313,13 @@ fn time_of(capture: &Capture, offset: usize) -> Option<f64> {
     capture.times.as_ref().and_then(|t| t.get(offset).copied())
 }
 
-/// How long the line was quiet before byte `i`, in ms, if longer than [`QUIET_GAP_S`].
+/// How long the line was quiet before byte `i`, in ms, if longer than the capture's quiet gap.
 fn gap_before(capture: &Capture, i: usize) -> Option<u32> {
     let times = capture.times.as_ref()?;
     let (a, b) = (times.get(i.checked_sub(1)?)?, times.get(i)?);
     let gap = b - a;
-    (gap > QUIET_GAP_S).then(|| (gap * 1000.0).round().clamp(1.0, 60_000.0) as u32)
+    (gap > capture.quiet_s.unwrap_or(QUIET_GAP_S))
+        .then(|| (gap * 1000.0).round().clamp(1.0, 60_000.0) as u32)
 }
 
 /// The master → board side: its frames, each read (the index of its last byte and the register

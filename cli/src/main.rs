@@ -27,7 +27,7 @@ struct Cli {
     #[arg(long, global = true, value_name = "PATH")]
     port: Option<String>,
     /// Record both directions of the command's traffic into FILE, time-stamped (read it back
-    /// with `chassis decode FILE --input saleae-csv --master-analyzer master`).
+    /// with `chassis decode FILE --input saleae-csv --quiet-ms 40 --master-analyzer master`).
     #[arg(long, global = true, value_name = "FILE")]
     record: Option<String>,
     #[command(subcommand)]
@@ -62,6 +62,11 @@ enum Cmd {
         /// How frames are written.
         #[arg(long, value_enum, default_value = "json")]
         format: decode::Format,
+        /// A gap in the time stamps longer than MS is a quiet line (a logic analyser's capture:
+        /// 2; a `chassis record` capture, stamped when the host read the bytes: 40, as the host
+        /// driver judges).
+        #[arg(long, value_name = "MS", default_value = "2")]
+        quiet_ms: f64,
     },
     /// Print a master → board frame's bytes as hex.
     Encode {
@@ -128,7 +133,7 @@ enum Cmd {
         speed: String,
     },
     /// Capture what the board sends, time-stamped, into a file `chassis decode --input
-    /// saleae-csv` reads back (sends nothing; Ctrl-C ends it, the file complete).
+    /// saleae-csv --quiet-ms 40` reads back (sends nothing; Ctrl-C ends it, the file complete).
     Record {
         /// The capture file to write.
         #[arg(long, value_name = "FILE")]
@@ -224,7 +229,14 @@ fn run(cli: Cli) -> Result<(), String> {
             master_analyzer,
             input,
             format,
+            quiet_ms,
         } => {
+            if !(quiet_ms > 0.0 && quiet_ms <= 60_000.0) {
+                return Err(format!(
+                    "--quiet-ms: {quiet_ms} is out of range (above 0, up to 60000)"
+                ));
+            }
+            let quiet = Some(quiet_ms / 1000.0);
             if master.is_some()
                 && (master.as_deref() == Some("-") || file.as_deref().is_none_or(|f| f == "-"))
             {
@@ -240,14 +252,18 @@ fn run(cli: Cli) -> Result<(), String> {
             }
             let data = read_input(file.as_deref())?;
             if let Some(name) = master_analyzer {
-                let (board, master) = decode::parse_saleae_sides(&data, &name)?;
+                let (mut board, mut master) = decode::parse_saleae_sides(&data, &name)?;
+                board.quiet_s = quiet;
+                master.quiet_s = quiet;
                 let decoded = decode::decode_both(&board, &master)?;
                 return write_decoded(&decoded, format);
             }
-            let capture = decode::read_capture(&data, input)?;
+            let mut capture = decode::read_capture(&data, input)?;
+            capture.quiet_s = quiet;
             let decoded = match master {
                 Some(path) => {
-                    let master = decode::read_capture(&read_input(Some(&path))?, input)?;
+                    let mut master = decode::read_capture(&read_input(Some(&path))?, input)?;
+                    master.quiet_s = quiet;
                     decode::decode_both(&capture, &master)?
                 }
                 None => decode::decode(&capture, uplink),

@@ -1,6 +1,8 @@
 //! The board's serial port as the CLI opens it: refused clearly when the path is no serial
 //! port, and optionally recorded, both directions time-stamped, as a Saleae Logic 2 export
-//! (`chassis decode FILE --input saleae-csv`, `--master-analyzer master` for both sides).
+//! (`chassis decode FILE --input saleae-csv --quiet-ms 40`, `--master-analyzer master` for
+//! both sides). The bytes are stamped when the host read them, so a quiet line is what the
+//! host driver takes for one: 40 ms ([`chassis_protocol::driver::Config::HOST`]).
 
 use chassis_protocol::driver::Config;
 use chassis_protocol::driver::blocking::Driver;

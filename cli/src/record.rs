@@ -1,5 +1,6 @@
 //! `chassis record`: what the board sends, time-stamped, into a file `chassis decode` reads
-//! back exactly (a Saleae Logic 2 export: quiet lines are gaps in the time stamps). Sends
+//! back exactly (a Saleae Logic 2 export: quiet lines are gaps in the time stamps, 40 ms as
+//! the host driver judges them: `--quiet-ms 40`). Sends
 //! nothing. Ends after `--for`, or on Ctrl-C (SIGINT, SIGTERM, SIGHUP) with the file complete.
 
 use crate::device::explain;
@@ -35,7 +36,8 @@ pub fn record(path: &str, out: &str, seconds: Option<f64>) -> Result<(), String>
     while signals::caught().is_none() && end.is_none_or(|end| Instant::now() < end) {
         match driver.poll() {
             Ok(Some(Event::Telemetry(_) | Event::Reply(_) | Event::StrayReply(_))) => frames += 1,
-            Ok(None) => std::thread::sleep(Duration::from_millis(2)),
+            // The poll waited up to a millisecond for a byte.
+            Ok(None) => {}
             Err(e) => {
                 error = Some(explain(&driver, e));
                 break;
@@ -56,7 +58,7 @@ pub fn record(path: &str, out: &str, seconds: Option<f64>) -> Result<(), String>
         .finish_recording()
         .unwrap_or(Ok(port::Counts::default()))?;
     let summary = format!(
-        "recorded {} bytes from the board ({frames} frames) in {:.1} s to {out}; read it back: chassis decode {out} --input saleae-csv",
+        "recorded {} bytes from the board ({frames} frames) in {:.1} s to {out}; read it back: chassis decode {out} --input saleae-csv --quiet-ms 40",
         counts.board_bytes,
         start.elapsed().as_secs_f64()
     );

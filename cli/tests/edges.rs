@@ -341,3 +341,107 @@ fn a_board_gone_quiet_mid_drive_is_stopped_and_said() {
     assert_eq!(board.motion(), Motion::Velocity { x: 0, y: 0, z: 0 });
     assert!(harness::commands(&heard).last().is_some_and(|c| !moves(c)));
 }
+
+fn json_lines(bytes: &[u8]) -> Vec<serde_json::Value> {
+    String::from_utf8_lossy(bytes)
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("a JSON object per line"))
+        .collect()
+}
+
+#[test]
+fn record_ends_cleanly_on_ctrl_c_and_decodes_back_exactly() {
+    let board = TestBoard::start();
+    let dir = std::env::temp_dir().join(format!("chassis-record-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("capture.csv").to_string_lossy().into_owned();
+    let child = board.spawn(&["record", "--out", &file]);
+    std::thread::sleep(Duration::from_millis(1_500));
+    signal(&child, "INT");
+    let out = wait(child, 5);
+    assert!(
+        out.status.success(),
+        "Ctrl-C is how a recording ends: {}",
+        stderr(&out)
+    );
+    let said = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        said.contains("recorded") && said.contains("chassis decode"),
+        "{said}"
+    );
+    assert!(board.heard().is_empty(), "record sends nothing");
+
+    let decoded = chassis(&["decode", &file, "--input", "saleae-csv", "--quiet-ms", "40"]);
+    assert!(decoded.status.success(), "{}", stderr(&decoded));
+    let summary = stderr(&decoded);
+    // Exact: the decode finds every frame the live count found, no more, no fewer. Only a
+    // frame cut by the start or the end of the recording is thrown away.
+    let live: usize = said
+        .split(" frames)")
+        .next()
+        .and_then(|s| s.rsplit('(').next())
+        .and_then(|n| n.parse().ok())
+        .expect("the live frame count");
+    assert_eq!(json_lines(&decoded.stdout).len(), live, "{summary}");
+    let discarded: usize = summary
+        .split(" bytes discarded")
+        .next()
+        .and_then(|s| s.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .expect("the bytes discarded");
+    assert!(discarded < 30, "at most a frame cut at each end: {summary}");
+    let imu: Vec<u64> = json_lines(&decoded.stdout)
+        .iter()
+        .filter(|f| f["frame"] == "imu")
+        .map(|f| f["count"].as_u64().unwrap())
+        .collect();
+    assert!(imu.len() > 100, "1.5 s of IMU at 100 Hz: {}", imu.len());
+    for pair in imu.windows(2) {
+        assert_eq!((pair[0] + 1) % 256, pair[1], "no IMU frame lost: {imu:?}");
+    }
+    println!("recorded 1.5 s: {} IMU frames; {summary}", imu.len());
+
+    // A file that cannot be written fails before the port is touched.
+    let out = board.run(&["record", "--out", "/nonexistent-folder/c.csv"]);
+    assert_error(&out, &["cannot write /nonexistent-folder/c.csv"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn record_flag_captures_both_sides_of_a_command() {
+    let board = TestBoard::start();
+    let dir = std::env::temp_dir().join(format!("chassis-record-both-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("get.csv").to_string_lossy().into_owned();
+    let out = board.run(&["--record", &file, "get", "max-speed"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let decoded = chassis(&[
+        "decode",
+        &file,
+        "--input",
+        "saleae-csv",
+        "--quiet-ms",
+        "40",
+        "--master-analyzer",
+        "master",
+    ]);
+    assert!(decoded.status.success(), "{}", stderr(&decoded));
+    let frames = json_lines(&decoded.stdout);
+    let reads: Vec<_> = frames.iter().filter(|f| f["from"] == "master").collect();
+    assert!(!reads.is_empty(), "the reads the command sent");
+    assert!(
+        reads
+            .iter()
+            .all(|f| f["frame"] == "read" && f["code"] == 0x11),
+        "{reads:?}"
+    );
+    let replies: Vec<_> = frames.iter().filter(|f| f["frame"] == "reply").collect();
+    assert!(
+        replies.len() >= 2
+            && replies
+                .iter()
+                .all(|f| f["value"] == 1_000 && f["from"] == "board"),
+        "a verified read is two replies of 1000: {replies:?}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
