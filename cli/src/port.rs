@@ -1,21 +1,45 @@
 //! The board's serial port as the CLI opens it: refused clearly when the path is no serial
 //! port, and optionally recorded, both directions time-stamped, as a Saleae Logic 2 export
 //! (`chassis decode FILE --input saleae-csv --quiet-ms 40`, `--master-analyzer master` for
-//! both sides). The bytes are stamped when the host read them, so a quiet line is what the
-//! host driver takes for one: 40 ms ([`chassis_protocol::driver::Config::HOST`]).
+//! both sides). The bytes are stamped with the driver's own clock readings, and a gap of more
+//! than 40 ms stands exactly where the host driver found the line quiet
+//! ([`chassis_protocol::driver::Config::HOST`]'s `idle_ms`): the decode of a recording sees
+//! the frames the driver saw.
 
-use chassis_protocol::driver::Config;
 use chassis_protocol::driver::blocking::Driver;
 use chassis_protocol::driver::host::{MonotonicClock, SerialError, SerialPort};
+use chassis_protocol::driver::{Clock, Config};
+use std::cell::Cell;
 use std::fs::File;
 use std::io::{BufWriter, Write as _};
-use std::time::Instant;
+use std::rc::Rc;
 
 /// A byte's time on the line at 115 200 bps (10 bits), in seconds.
 pub const BYTE_S: f64 = 10.0 / 115_200.0;
 
+/// A quiet line for the host driver ([`Config::HOST`]'s `idle_ms`), in seconds: a recording
+/// is decoded with `--quiet-ms 40`.
+#[allow(clippy::cast_lossless)]
+pub const QUIET_S: f64 = Config::HOST.idle_ms as f64 / 1000.0;
+
 /// The driver the CLI uses: the host driver over a [`Port`].
-pub type Board = Driver<Port, MonotonicClock>;
+pub type Board = Driver<Port, SharedClock>;
+
+/// The host's monotonic clock, each reading also shown to the [`Port`] (whose recording is
+/// stamped with the times the driver judges by).
+#[derive(Clone, Debug)]
+pub struct SharedClock {
+    clock: MonotonicClock,
+    last: Rc<Cell<u64>>,
+}
+
+impl Clock for SharedClock {
+    fn now_ms(&mut self) -> u64 {
+        let now = self.clock.now_ms();
+        self.last.set(now);
+        now
+    }
+}
 
 /// The capture file of `--record`, if given.
 static RECORD: std::sync::Mutex<Option<Recorder>> = std::sync::Mutex::new(None);
@@ -43,13 +67,18 @@ pub fn open(path: &str, record: Option<Recorder>) -> Result<Board, String> {
         }
     }
     let port = SerialPort::open(path).map_err(|e| format!("cannot open {path}: {}", e.0))?;
+    let clock = SharedClock {
+        clock: MonotonicClock::new(),
+        last: Rc::new(Cell::new(0)),
+    };
     Ok(Driver::new(
         Port {
             port,
             path: path.to_string(),
+            now: Rc::clone(&clock.last),
             record,
         },
-        MonotonicClock::new(),
+        clock,
         Config::HOST,
     ))
 }
@@ -59,6 +88,8 @@ pub fn open(path: &str, record: Option<Recorder>) -> Result<Board, String> {
 pub struct Port {
     port: SerialPort,
     path: String,
+    /// The driver's last clock reading, in ms.
+    now: Rc<Cell<u64>>,
     record: Option<Recorder>,
 }
 
@@ -85,7 +116,11 @@ impl embedded_io::ErrorType for Port {
 
 impl embedded_io::ReadReady for Port {
     fn read_ready(&mut self) -> Result<bool, SerialError> {
-        self.port.read_ready()
+        let ready = self.port.read_ready()?;
+        if let (false, Some(record)) = (ready, self.record.as_mut()) {
+            record.nothing_waiting(self.now.get());
+        }
+        Ok(ready)
     }
 }
 
@@ -93,7 +128,7 @@ impl embedded_io::Read for Port {
     fn read(&mut self, buf: &mut [u8]) -> Result<usize, SerialError> {
         let n = self.port.read(buf)?;
         if let (Some(record), Some(bytes)) = (self.record.as_mut(), buf.get(..n)) {
-            record.board(bytes);
+            record.board(bytes, self.now.get());
         }
         Ok(n)
     }
@@ -103,7 +138,7 @@ impl embedded_io::Write for Port {
     fn write(&mut self, buf: &[u8]) -> Result<usize, SerialError> {
         let n = self.port.write(buf)?;
         if let (Some(record), Some(bytes)) = (self.record.as_mut(), buf.get(..n)) {
-            record.master(bytes);
+            record.master(bytes, self.now.get());
         }
         Ok(n)
     }
@@ -123,14 +158,20 @@ pub struct Counts {
 }
 
 /// A capture file being written: `name,type,start_time,duration,data` rows, one per byte,
-/// `board` or `master`, times in seconds from the start.
+/// `board` or `master`, times in seconds of the driver's clock.
 #[derive(Debug)]
 pub struct Recorder {
     out: BufWriter<File>,
     path: String,
-    start: Instant,
     /// When the last byte of each side started, in s.
     last: [f64; 2],
+    /// The driver's clock when bytes from the board last came, in ms.
+    last_read_ms: Option<u64>,
+    /// The driver has found the line quiet since then (as its `tick` judges: nothing waiting,
+    /// and `idle_ms` since the last byte).
+    quiet_seen: bool,
+    /// This program sent bytes since the board's last were read.
+    sent_since_read: bool,
     counts: Counts,
     error: Option<String>,
 }
@@ -145,8 +186,10 @@ impl Recorder {
         Ok(Recorder {
             out,
             path: path.to_string(),
-            start: Instant::now(),
             last: [f64::NEG_INFINITY; 2],
+            last_read_ms: None,
+            quiet_seen: true,
+            sent_since_read: false,
             counts: Counts::default(),
             error: None,
         })
@@ -157,19 +200,53 @@ impl Recorder {
         self.counts
     }
 
-    /// Bytes the board sent, just read: they came one after the other and ended about now.
-    fn board(&mut self, bytes: &[u8]) {
-        let now = self.start.elapsed().as_secs_f64();
-        let first = now - BYTE_S * bytes.len() as f64;
+    /// The port had nothing to read at the driver's `now_ms`: the driver finds the line quiet
+    /// if nothing came for its `idle_ms`.
+    fn nothing_waiting(&mut self, now_ms: u64) {
+        let idle = u64::from(Config::HOST.idle_ms);
+        if self
+            .last_read_ms
+            .is_none_or(|t| now_ms.saturating_sub(t) >= idle)
+        {
+            self.quiet_seen = true;
+        }
+    }
+
+    /// Bytes the board sent, read at the driver's `now_ms`: they came one after the other and
+    /// ended about then. The gap before them is longer than [`QUIET_S`] exactly when the
+    /// driver found the line quiet in between.
+    fn board(&mut self, bytes: &[u8], now_ms: u64) {
+        if bytes.is_empty() {
+            return;
+        }
+        let now = now_ms as f64 / 1000.0;
+        let arrived = now - BYTE_S * bytes.len() as f64;
+        let last = self.last.first().copied().unwrap_or(f64::NEG_INFINITY);
+        let first = if self.quiet_seen {
+            arrived.max(last + QUIET_S + 0.000_5)
+        } else {
+            arrived.min(last + QUIET_S - 0.005)
+        };
+        // Read after something this program sent: stamped after it (the clock's millisecond
+        // steps could put a reply before its read, which a decode would not await).
+        let sent = self.last.get(1).copied().unwrap_or(f64::NEG_INFINITY);
+        let first = if self.sent_since_read {
+            first.max(sent + BYTE_S)
+        } else {
+            first
+        };
+        self.sent_since_read = false;
+        self.quiet_seen = false;
+        self.last_read_ms = Some(now_ms);
         self.counts.board_bytes += bytes.len() as u64;
         self.rows(0, first, bytes);
     }
 
-    /// Bytes this program sent, just handed to the port: they leave from now on.
-    fn master(&mut self, bytes: &[u8]) {
-        let now = self.start.elapsed().as_secs_f64();
+    /// Bytes this program sent at the driver's `now_ms`: they leave from then on.
+    fn master(&mut self, bytes: &[u8], now_ms: u64) {
+        self.sent_since_read = true;
         self.counts.master_bytes += bytes.len() as u64;
-        self.rows(1, now, bytes);
+        self.rows(1, now_ms as f64 / 1000.0, bytes);
     }
 
     fn rows(&mut self, side: usize, first: f64, bytes: &[u8]) {
