@@ -3,6 +3,7 @@
 //! (a missing port, a file that is not there, odd hex, a value out of range, a silent board)
 //! is one line on stderr and a non-zero exit.
 
+mod check;
 mod decode;
 mod device;
 mod encode;
@@ -132,6 +133,21 @@ enum Cmd {
         #[arg(long, default_value = "300")]
         speed: String,
     },
+    /// Check a board end to end: the firmware's bring-up from this PC (link and rates, every
+    /// register, drive type, forward, sideways, a 90° turn, stop, battery, a control loop).
+    /// Exit status 0 when every check passes, else the failed check's code (10..=18).
+    Check {
+        /// Only what neither moves the chassis nor writes to the board: link, registers,
+        /// battery.
+        #[arg(long)]
+        no_motion: bool,
+        /// Do not ask before the chassis moves.
+        #[arg(long)]
+        yes: bool,
+        /// Set this drive type on the board (the board's own is kept if not given).
+        #[arg(long, value_enum, value_name = "TYPE")]
+        drive_type: Option<DriveTypeName>,
+    },
     /// Capture what the board sends, time-stamped, into a file `chassis decode --input
     /// saleae-csv --quiet-ms 40` reads back (sends nothing; Ctrl-C ends it, the file complete).
     Record {
@@ -159,8 +175,60 @@ enum Cmd {
     },
 }
 
+/// A drive type, by name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum DriveTypeName {
+    /// 0: omni wheels.
+    Omni,
+    /// 1: mecanum wheels.
+    Mecanum,
+    /// 2: differential, with encoders.
+    Differential,
+    /// 3: differential, without encoders (duty cycles).
+    DifferentialOpenLoop,
+}
+
+impl DriveTypeName {
+    const fn drive_type(self) -> chassis_protocol::DriveType {
+        use chassis_protocol::DriveType;
+        match self {
+            DriveTypeName::Omni => DriveType::Omni,
+            DriveTypeName::Mecanum => DriveType::Mecanum,
+            DriveTypeName::Differential => DriveType::Differential,
+            DriveTypeName::DifferentialOpenLoop => DriveType::DifferentialOpenLoop,
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Cmd::Check {
+        no_motion,
+        yes,
+        drive_type,
+    } = cli.command
+    {
+        let result = port(cli.port.as_deref())
+            .map_err(|e| (e, 1))
+            .and_then(|path| {
+                if let Some(file) = &cli.record {
+                    port::record_to(file).map_err(|e| (e, 1))?;
+                }
+                check::check(
+                    path,
+                    no_motion,
+                    yes,
+                    drive_type.map(DriveTypeName::drive_type),
+                )
+            });
+        return match result {
+            Ok(()) => ExitCode::SUCCESS,
+            Err((message, code)) => {
+                eprintln!("chassis: {message}");
+                ExitCode::from(code)
+            }
+        };
+    }
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
@@ -296,6 +364,8 @@ fn run(cli: Cli) -> Result<(), String> {
             let speed = value::parse_i32(&speed, "speed", 1, 65_535)?;
             monitor::run(port(p)?, drive, speed)
         }
+        // Run from `main`: its exit status is the verdict.
+        Cmd::Check { .. } => Err("check: run from main".into()),
         Cmd::Record { out, seconds } => record::record(port(p)?, &out, seconds),
         Cmd::Sim {
             pty,

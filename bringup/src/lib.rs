@@ -37,6 +37,24 @@
 #[cfg(all(feature = "blocking", feature = "async"))]
 compile_error!("features `blocking` and `async` exclude each other: a board picks one");
 
+/// The bring-up's log: defmt with feature `defmt`; without it, nothing (a PC follows the
+/// bring-up through [`Link::note`] instead).
+#[cfg(feature = "defmt")]
+macro_rules! log {
+    ($level:ident, $($t:tt)*) => {
+        defmt::$level!($($t)*)
+    };
+}
+
+/// The bring-up's log: defmt with feature `defmt`; without it, nothing (a PC follows the
+/// bring-up through [`Link::note`] instead).
+#[cfg(not(feature = "defmt"))]
+macro_rules! log {
+    ($level:ident, $fmt:literal $(, $arg:expr)* $(,)?) => {{
+        $(let _ = &$arg;)*
+    }};
+}
+
 pub mod link;
 
 /// embassy-time as the driver's clock (feature `embassy`).
@@ -59,10 +77,15 @@ use chassis_protocol::{Downlink, DriveType, Kind, Register, Stream, Turn, Veloci
 pub use link::{Link, LinkError};
 
 /// What the bring-up does, and how long each step takes.
-#[derive(Clone, Copy, Debug, defmt::Format)]
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Plan {
-    /// The chassis's drive type, as built.
-    pub drive: DriveType,
+    /// The chassis's drive type, as built: written to the board if it has another. `None`:
+    /// the board's own is kept (and reported).
+    pub drive: Option<DriveType>,
+    /// Whether the chassis may move. `false`: only [`Check::Link`], [`Check::Settings`] and
+    /// [`Check::Battery`] run (nothing is written, nothing moves); the others are skipped.
+    pub motion: bool,
     /// How long telemetry is listened to before rates are judged, ms (at least 1 s: battery
     /// frames come at 1 Hz).
     pub listen_ms: u64,
@@ -91,7 +114,8 @@ pub struct Plan {
 impl Plan {
     /// The bring-up every board runs by default: about 6 s end to end.
     pub const DEFAULT: Plan = Plan {
-        drive: DriveType::Mecanum,
+        drive: Some(DriveType::Mecanum),
+        motion: true,
         listen_ms: 1_200,
         speed: 300,
         drive_ms: 400,
@@ -106,7 +130,8 @@ impl Plan {
 }
 
 /// A step of the bring-up.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Check {
     /// Telemetry arrives at its rates.
     Link,
@@ -129,6 +154,40 @@ pub enum Check {
 }
 
 impl Check {
+    /// Every check, in the order the bring-up runs them.
+    pub const ALL: [Check; 9] = [
+        Check::Link,
+        Check::Settings,
+        Check::DriveType,
+        Check::Forward,
+        Check::Strafe,
+        Check::Turn,
+        Check::Stop,
+        Check::Battery,
+        Check::ControlLoop,
+    ];
+
+    /// Its name in logs and on a PC's screen.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Check::Link => "link",
+            Check::Settings => "settings",
+            Check::DriveType => "drive-type",
+            Check::Forward => "forward",
+            Check::Strafe => "strafe",
+            Check::Turn => "turn",
+            Check::Stop => "stop",
+            Check::Battery => "battery",
+            Check::ControlLoop => "control-loop",
+        }
+    }
+
+    /// Whether it moves the chassis or writes to the board (skipped when
+    /// [`Plan::motion`] is `false`).
+    pub const fn moves(self) -> bool {
+        !matches!(self, Check::Link | Check::Settings | Check::Battery)
+    }
+
     /// The process exit code under QEMU when this check fails (0 means every check passed).
     pub const fn exit_code(self) -> i32 {
         match self {
@@ -145,8 +204,21 @@ impl Check {
     }
 }
 
+/// What the bring-up is doing, for a program that shows its progress ([`Link::note`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Note {
+    /// A check starts.
+    Start(Check),
+    /// A check passed.
+    Passed(Check),
+    /// A check is skipped (no motion, or nothing to do).
+    Skipped(Check),
+}
+
 /// Why a check failed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Why {
     /// The driver failed (transport error, timeout, unconfirmed read…).
     Driver(LinkError),
@@ -168,10 +240,14 @@ pub enum Why {
     NoBattery,
     /// The driver's failsafe stopped the chassis: the board went quiet.
     FailsafeStop,
+    /// No encoder frame came during a drive: the board went quiet (before the failsafe's
+    /// time was up: it allows a board more after a settings frame).
+    NoEncoderFrames,
 }
 
 /// A failed check and why.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, defmt::Format)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Failure {
     /// The check that failed.
     pub check: Check,
@@ -180,7 +256,8 @@ pub struct Failure {
 }
 
 /// What a passed bring-up measured.
-#[derive(Clone, Copy, Debug, Default, defmt::Format)]
+#[derive(Clone, Copy, Debug, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Report {
     /// Frames per 10 s of each stream: IMU, encoders, battery.
     pub rates_per_10s: [u32; 3],
@@ -227,9 +304,9 @@ fn fail(check: Check) -> impl Fn(LinkError) -> Failure {
 pub async fn bring_up<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
     let result = steps(link, plan).await;
     if let Err(failure) = &result {
-        defmt::error!("bring-up: {} failed: {}", failure.check, failure.why);
+        log!(error, "bring-up: {} failed: {}", failure.check, failure.why);
         if let Err(e) = link.stop().await {
-            defmt::error!("stop after the failure: {}", e);
+            log!(error, "stop after the failure: {}", e);
         }
     }
     result
@@ -240,12 +317,12 @@ pub async fn bring_up<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Fail
 #[maybe_async::maybe_async]
 pub async fn bring_up_and_park<L: Link>(link: &mut L, plan: &Plan) -> ! {
     match bring_up(link, plan).await {
-        Ok(report) => defmt::info!("PASS: every check passed: {}", report),
-        Err(failure) => defmt::error!("FAIL: {} ({})", failure.check, failure.why),
+        Ok(report) => log!(info, "PASS: every check passed: {}", report),
+        Err(failure) => log!(error, "FAIL: {} ({})", failure.check, failure.why),
     }
     loop {
         if let Err(e) = link.poll().await {
-            defmt::warn!("link: {}", e);
+            log!(warn, "link: {}", e);
         }
     }
 }
@@ -255,7 +332,12 @@ async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
     let mut report = Report::default();
 
     // 1. Link up: count each stream's frames over the listening time.
-    defmt::info!("[link] listening to telemetry for {} ms", plan.listen_ms);
+    link.note(Note::Start(Check::Link));
+    log!(
+        info,
+        "[link] listening to telemetry for {} ms",
+        plan.listen_ms
+    );
     let mut counts = [0u32; 3];
     let start = link.now_ms();
     while link.now_ms().saturating_sub(start) < plan.listen_ms {
@@ -287,7 +369,8 @@ async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
             _ => per_10s >= nominal_per_10s * 7 / 10,
         };
         if !enough {
-            defmt::warn!(
+            log!(
+                warn,
                 "[link] frames {} in {} ms; parser {}",
                 counts,
                 elapsed,
@@ -299,32 +382,100 @@ async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
             });
         }
     }
-    defmt::info!(
+    log!(
+        info,
         "[link] up: IMU {} Hz, encoders {} Hz, battery {} frame(s)",
         report.rates_per_10s[0] / 10,
         report.rates_per_10s[1] / 10,
         counts[2]
     );
 
+    link.note(Note::Passed(Check::Link));
+
     // 2. Every register, and the pending angle.
+    link.note(Note::Start(Check::Settings));
     let snapshot = link.read_settings().await.map_err(fail(Check::Settings))?;
     report.pending_before = link.turn_remaining().await.map_err(fail(Check::Settings))?;
     report.snapshot = snapshot;
-    defmt::info!("[settings] {}", snapshot);
-    defmt::info!("[settings] pending angle {} (0.1°)", report.pending_before);
+    log!(info, "[settings] {}", snapshot);
+    log!(
+        info,
+        "[settings] pending angle {} (0.1°)",
+        report.pending_before
+    );
     let mut buf = [0u8; SNAPSHOT_POSTCARD_MAX];
     let encoded = encode_snapshot(&snapshot, &mut buf);
-    defmt::info!(
+    log!(
+        info,
         "[settings] postcard ({} bytes): {=[u8]:02x}",
         encoded.len(),
         encoded
     );
 
-    // 3. The build's drive type.
-    if snapshot.system_mode.drive_type() == plan.drive {
-        defmt::info!("[drive-type] already {}", plan.drive);
+    link.note(Note::Passed(Check::Settings));
+
+    let failsafe_before = link.core().failsafe_stops();
+    if plan.motion {
+        motion_checks(link, plan, &snapshot, &mut report, failsafe_before).await?;
     } else {
-        let mode = snapshot.system_mode.with_drive_type(plan.drive);
+        for check in [
+            Check::DriveType,
+            Check::Forward,
+            Check::Strafe,
+            Check::Turn,
+            Check::Stop,
+        ] {
+            link.note(Note::Skipped(check));
+        }
+    }
+
+    // 7. Battery: above the cut-off. One frame can carry a changed byte (no checksum), so a
+    // reading at or below the limit is judged again on the next frame before it fails.
+    link.note(Note::Start(Check::Battery));
+    battery(link, plan, &snapshot, &mut report).await?;
+    link.note(Note::Passed(Check::Battery));
+
+    // 8. The steady control loop, reads while moving.
+    if plan.motion {
+        link.note(Note::Start(Check::ControlLoop));
+        control_loop(link, plan, &mut report, failsafe_before).await?;
+        link.note(Note::Passed(Check::ControlLoop));
+    } else {
+        link.note(Note::Skipped(Check::ControlLoop));
+    }
+
+    let missed = Stream::ALL
+        .into_iter()
+        .map(|s| link.core().stream(s).missed)
+        .fold(0u32, u32::saturating_add);
+    report.missed = missed;
+    Ok(report)
+}
+
+/// Checks 3 to 6: the drive type, forward, sideways, the turn, the stop.
+#[maybe_async::maybe_async]
+async fn motion_checks<L: Link>(
+    link: &mut L,
+    plan: &Plan,
+    snapshot: &Snapshot,
+    report: &mut Report,
+    failsafe_before: u32,
+) -> Result<(), Failure> {
+    // 3. The build's drive type.
+    let Some(drive) = plan.drive else {
+        log!(
+            info,
+            "[drive-type] kept: {}",
+            snapshot.system_mode.drive_type()
+        );
+        link.note(Note::Skipped(Check::DriveType));
+        return moving_checks(link, plan, report, failsafe_before).await;
+    };
+    link.note(Note::Start(Check::DriveType));
+    if snapshot.system_mode.drive_type() == drive {
+        log!(info, "[drive-type] already {}", drive);
+    } else {
+        let mode = snapshot.system_mode.with_drive_type(drive);
         link.write(Write::SystemMode(mode))
             .await
             .map_err(fail(Check::DriveType))?;
@@ -333,25 +484,37 @@ async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
             .await
             .map_err(fail(Check::DriveType))?;
         let read_back = chassis_protocol::SystemMode::from_bits(raw).drive_type();
-        if read_back != plan.drive {
+        if read_back != drive {
             return Err(Failure {
                 check: Check::DriveType,
                 why: Why::DriveTypeNotSet(read_back),
             });
         }
-        defmt::info!(
+        log!(
+            info,
             "[drive-type] {} -> {}",
             snapshot.system_mode.drive_type(),
-            plan.drive
+            drive
         );
     }
+    link.note(Note::Passed(Check::DriveType));
+    moving_checks(link, plan, report, failsafe_before).await
+}
 
+/// Checks 4 to 6: forward, sideways, the turn, the stop.
+#[maybe_async::maybe_async]
+async fn moving_checks<L: Link>(
+    link: &mut L,
+    plan: &Plan,
+    report: &mut Report,
+    failsafe_before: u32,
+) -> Result<(), Failure> {
     // 4. Forward and sideways: the encoders must count.
-    let failsafe_before = link.core().failsafe_stops();
     for (check, velocity, slot) in [
         (Check::Forward, Velocity::new(0, plan.speed, 0), 0usize),
         (Check::Strafe, Velocity::new(plan.speed, 0, 0), 1),
     ] {
+        link.note(Note::Start(check));
         let moved = drive_for(link, plan, velocity, plan.drive_ms, check).await?;
         if link.core().failsafe_stops() != failsafe_before {
             return Err(Failure {
@@ -368,15 +531,17 @@ async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
         if let Some(t) = report.ticks.get_mut(slot) {
             *t = moved.ticks;
         }
-        defmt::info!("[{}] encoders counted {} ticks", check, moved.ticks);
+        log!(info, "[{}] encoders counted {} ticks", check, moved.ticks);
+        link.note(Note::Passed(check));
     }
 
     // 5. One turn, sent once; wait for the pending angle to reach 0.
+    link.note(Note::Start(Check::Turn));
     link.stop().await.map_err(fail(Check::Turn))?;
     link.turn(Turn::by_deci_degrees(plan.turn_deci_degrees))
         .await
         .map_err(fail(Check::Turn))?;
-    defmt::info!("[turn] {} (0.1°) sent once", plan.turn_deci_degrees);
+    log!(info, "[turn] {} (0.1°) sent once", plan.turn_deci_degrees);
     let start = link.now_ms();
     let mut next_read = start.saturating_add(200);
     let mut gyro_peak = 0u16;
@@ -414,13 +579,17 @@ async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
             why: Why::GyroStill,
         });
     }
-    defmt::info!(
+    log!(
+        info,
         "[turn] done in {} ms, gyro Z peak {}",
         link.now_ms().saturating_sub(start),
         gyro_peak
     );
 
+    link.note(Note::Passed(Check::Turn));
+
     // 6. Stop: the encoders stand still (after 100 ms to settle).
+    link.note(Note::Start(Check::Stop));
     link.stop().await.map_err(fail(Check::Stop))?;
     let _ = drive_for(link, plan, Velocity::new(0, 0, 0), 100, Check::Stop).await?;
     let still = drive_for(link, plan, Velocity::new(0, 0, 0), 200, Check::Stop).await?;
@@ -430,10 +599,19 @@ async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
             why: Why::EncodersMoving,
         });
     }
-    defmt::info!("[stop] encoders still");
+    log!(info, "[stop] encoders still");
+    link.note(Note::Passed(Check::Stop));
+    Ok(())
+}
 
-    // 7. Battery: above the cut-off. One frame can carry a changed byte (no checksum), so a
-    // reading at or below the limit is judged again on the next frame before it fails.
+/// Check 7: the battery is above its cut-off.
+#[maybe_async::maybe_async]
+async fn battery<L: Link>(
+    link: &mut L,
+    plan: &Plan,
+    snapshot: &Snapshot,
+    report: &mut Report,
+) -> Result<(), Failure> {
     let limit = if snapshot.battery_cutoff_centivolts == 0x7FFF {
         plan.min_centivolts
     } else {
@@ -465,14 +643,24 @@ async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
             why: Why::LowBattery(battery.centivolts, limit),
         });
     }
-    defmt::info!(
+    log!(
+        info,
         "[battery] {} cV ({} %), cut-off {} cV",
         battery.centivolts,
         battery.percent,
         limit
     );
+    Ok(())
+}
 
-    // 8. The steady control loop, reads while moving.
+/// Check 8: the steady control loop (reads while moving), then stop.
+#[maybe_async::maybe_async]
+async fn control_loop<L: Link>(
+    link: &mut L,
+    plan: &Plan,
+    report: &mut Report,
+    failsafe_before: u32,
+) -> Result<(), Failure> {
     let cruise = Velocity::new(0, plan.speed / 2, 0);
     let start = link.now_ms();
     let mut next_send = start;
@@ -505,18 +693,13 @@ async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
     }
     link.stop().await.map_err(fail(Check::ControlLoop))?;
     report.loop_reads = reads;
-    defmt::info!(
+    log!(
+        info,
         "[control-loop] {} ms, {} reads while moving, no failsafe stop",
         plan.loop_ms,
         reads
     );
-
-    let missed = Stream::ALL
-        .into_iter()
-        .map(|s| link.core().stream(s).missed)
-        .fold(0u32, u32::saturating_add);
-    report.missed = missed;
-    Ok(report)
+    Ok(())
 }
 
 /// What a timed drive saw.
@@ -558,6 +741,12 @@ async fn drive_for<L: Link>(
             first.get_or_insert(e.ticks);
             last = Some(e.ticks);
         }
+    }
+    if velocity != Velocity::new(0, 0, 0) && first.is_none() {
+        return Err(Failure {
+            check,
+            why: Why::NoEncoderFrames,
+        });
     }
     let ticks = match (first, last) {
         (Some(a), Some(b)) => a

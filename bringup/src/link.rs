@@ -5,7 +5,9 @@
 //! `async`) wraps the async one (embassy's `BufferedUart`). With `blocking`, [`Link`]'s calls
 //! are plain functions and the bring-up is plain blocking code: no executor, no future.
 
-use chassis_protocol::driver::{Clock, CoreError, DriverCore, Error, Event, Outcome, Request};
+#[cfg(any(feature = "blocking", feature = "async"))]
+use chassis_protocol::driver::{Clock, CoreError, Outcome, Request};
+use chassis_protocol::driver::{DriverCore, Error, Event};
 use chassis_protocol::registers::Snapshot;
 use chassis_protocol::{Register, Turn, Velocity, Write};
 
@@ -13,6 +15,7 @@ use chassis_protocol::{Register, Turn, Velocity, Write};
 /// every HAL.
 pub type LinkError = Error<embedded_io::ErrorKind>;
 
+#[cfg(any(feature = "blocking", feature = "async"))]
 fn kind<E: embedded_io::Error>(e: Error<E>) -> LinkError {
     e.map_transport(|e| e.kind())
 }
@@ -46,6 +49,11 @@ pub trait Link {
     async fn read_verified(&mut self, register: Register) -> Result<u32, LinkError>;
     /// One register write.
     async fn write(&mut self, write: Write) -> Result<(), LinkError>;
+    /// What the bring-up is doing (a check starts, passes, is skipped): for a program that
+    /// shows its progress. Does nothing unless implemented.
+    fn note(&mut self, note: crate::Note) {
+        let _ = note;
+    }
 }
 
 /// The blocking driver as a [`Link`] (feature `blocking`; the clock is copied: it must be a
@@ -68,9 +76,23 @@ where
         Blocking { driver, clock }
     }
 
+    /// Wraps a blocking driver already made (opened on a PC's serial port, say); `clock` is
+    /// a copy of its clock.
+    pub const fn from_driver(
+        driver: chassis_protocol::driver::blocking::Driver<U, C>,
+        clock: C,
+    ) -> Self {
+        Blocking { driver, clock }
+    }
+
     /// The driver, for what the bring-up does not use.
     pub fn driver(&mut self) -> &mut chassis_protocol::driver::blocking::Driver<U, C> {
         &mut self.driver
+    }
+
+    /// The driver back.
+    pub fn into_driver(self) -> chassis_protocol::driver::blocking::Driver<U, C> {
+        self.driver
     }
 }
 
