@@ -21,7 +21,8 @@
 //!    [`Plan::command_period_ms`]; the encoders must count.
 //! 5. [`Check::Turn`]: one 90° turn, sent **once** (the board adds turns up); the gyro must see
 //!    it and the pending angle must reach 0.
-//! 6. [`Check::Stop`]: after a stop, the encoders stand still.
+//! 6. [`Check::Stop`]: after a stop, the encoders stand still (most encoder frames in a row
+//!    agree: one frame with a changed byte is not motion).
 //! 7. [`Check::Battery`]: the battery is above its cut-off (a reading at or below it is judged
 //!    again on the next battery frame: one frame can carry a changed byte).
 //! 8. [`Check::ControlLoop`]: a steady control loop (slow forward, the velocity re-sent each
@@ -593,7 +594,16 @@ async fn moving_checks<L: Link>(
     link.stop().await.map_err(fail(Check::Stop))?;
     let _ = drive_for(link, plan, Velocity::new(0, 0, 0), 100, Check::Stop).await?;
     let still = drive_for(link, plan, Velocity::new(0, 0, 0), 200, Check::Stop).await?;
-    if still.ticks != 0 {
+    // Still: the counters of most frames in a row agree. One frame can carry a changed byte
+    // (no checksum), which changes the two pairs it is in; a chassis still moving changes
+    // every pair.
+    if still.pairs == 0 {
+        return Err(Failure {
+            check: Check::Stop,
+            why: Why::NoEncoderFrames,
+        });
+    }
+    if still.changed_pairs.saturating_mul(2) > still.pairs {
         return Err(Failure {
             check: Check::Stop,
             why: Why::EncodersMoving,
@@ -706,6 +716,9 @@ async fn control_loop<L: Link>(
 struct Moved {
     /// Sum over the wheels of |ticks at the end − ticks at the start|.
     ticks: u32,
+    /// Encoder frames in a row (pairs) seen, and how many of them differ.
+    pairs: u32,
+    changed_pairs: u32,
 }
 
 /// Drives at `velocity` for `ms`, re-sending it every command period, taking telemetry in.
@@ -721,6 +734,7 @@ async fn drive_for<L: Link>(
     let mut next_send = start;
     let mut first: Option<[i16; 4]> = None;
     let mut last: Option<[i16; 4]> = None;
+    let (mut pairs, mut changed_pairs) = (0u32, 0u32);
     let failsafe_before = link.core().failsafe_stops();
     while link.now_ms().saturating_sub(start) < ms {
         // The driver stopped a board that went quiet: never command motion past that.
@@ -739,6 +753,12 @@ async fn drive_for<L: Link>(
             link.poll().await.map_err(fail(check))?
         {
             first.get_or_insert(e.ticks);
+            if let Some(previous) = last {
+                pairs = pairs.saturating_add(1);
+                if previous != e.ticks {
+                    changed_pairs = changed_pairs.saturating_add(1);
+                }
+            }
             last = Some(e.ticks);
         }
     }
@@ -756,5 +776,9 @@ async fn drive_for<L: Link>(
             .fold(0u32, u32::saturating_add),
         _ => 0,
     };
-    Ok(Moved { ticks })
+    Ok(Moved {
+        ticks,
+        pairs,
+        changed_pairs,
+    })
 }
