@@ -6,11 +6,9 @@
 
 mod harness;
 
-use chassis_protocol::sim::Faults;
 use chassis_protocol::{Command, DriveType, Setting};
 use harness::{TestBoard, assert_stopped, signal, wait};
-use std::io::{BufRead, BufReader};
-use std::process::{Output, Stdio};
+use std::process::Output;
 use std::time::Duration;
 
 fn text(out: &Output) -> (String, String) {
@@ -18,16 +16,6 @@ fn text(out: &Output) -> (String, String) {
         String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
-}
-
-fn turns(commands: &[Command]) -> Vec<i32> {
-    commands
-        .iter()
-        .filter_map(|c| match c {
-            Command::Turn(t) => Some(t.deci_degrees),
-            _ => None,
-        })
-        .collect()
 }
 
 #[test]
@@ -55,7 +43,7 @@ fn a_working_board_passes_every_check_and_ends_stopped() {
     let (board, heard) = board.finish();
     assert_stopped(&board, &heard);
     assert_eq!(
-        turns(&harness::commands(&heard)),
+        harness::turns(&harness::commands(&heard)),
         vec![900],
         "one turn, sent once"
     );
@@ -158,7 +146,7 @@ fn ctrl_c_mid_turn_cancels_it_and_stops() {
     );
     let (board, heard) = board.finish();
     assert_stopped(&board, &heard);
-    let turns = turns(&harness::commands(&heard));
+    let turns = harness::turns(&harness::commands(&heard));
     assert_eq!(turns.first(), Some(&900));
     assert_eq!(turns.len(), 2, "the turn, then its cancel: {turns:?}");
 }
@@ -177,17 +165,8 @@ fn a_silent_board_fails_the_link_check_with_the_wiring_hint() {
 #[test]
 fn check_passes_through_chassis_sim_with_line_faults() {
     // `chassis sim --pty` with 1e-3 line errors per byte (dropped, changed, added).
-    let mut sim = std::process::Command::new(env!("CARGO_BIN_EXE_chassis"))
-        .args(["sim", "--pty", "--faults", "1e-3", "--seed", "7"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut path = String::new();
-    BufReader::new(sim.stdout.take().unwrap())
-        .read_line(&mut path)
-        .unwrap();
-    let out = harness::chassis(&["--port", path.trim(), "check", "--yes"]);
+    let (mut sim, path) = harness::sim_pty(&["--faults", "1e-3", "--seed", "7"]);
+    let out = harness::chassis(&["--port", &path, "check", "--yes"]);
     let _ = sim.kill();
     let _ = sim.wait();
     let (stdout, stderr) = text(&out);
@@ -197,5 +176,4 @@ fn check_passes_through_chassis_sim_with_line_faults() {
         stdout.contains("PASS: 8 checks passed, 1 skipped"),
         "{stdout}"
     );
-    let _ = Faults::default();
 }

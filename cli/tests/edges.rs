@@ -32,14 +32,13 @@ const SIGNALS: [(&str, i32); 3] = [("INT", 2), ("TERM", 15), ("HUP", 1)];
 fn every_signal_during_drive_stops_the_chassis() {
     for (name, number) in SIGNALS {
         let board = TestBoard::start();
-        let child = board.spawn(&["drive", "--y", "300", "--for", "20"]);
-        board.wait_for(
+        let out = board.signal_mid(
+            &["drive", "--y", "300", "--for", "20"],
             "y = 300",
-            |c| matches!(c, Command::Velocity(v) if v.y == 300),
+            harness::forward(300),
+            300,
+            name,
         );
-        std::thread::sleep(Duration::from_millis(300));
-        signal(&child, name);
-        let out = wait(child, 5);
         assert_eq!(out.status.code(), Some(128 + number), "SIG{name}: {out:?}");
         assert!(
             stderr(&out).contains(&format!(
@@ -62,27 +61,20 @@ fn every_signal_during_drive_stops_the_chassis() {
 fn every_signal_during_turn_cancels_the_turn_and_stops() {
     for (name, number) in SIGNALS {
         let board = TestBoard::start();
-        let child = board.spawn(&["turn", "360"]);
-        board.wait_for(
+        let out = board.signal_mid(
+            &["turn", "360"],
             "the turn",
             |c| matches!(c, Command::Turn(t) if t.deci_degrees == 3_600),
+            400,
+            name,
         );
-        std::thread::sleep(Duration::from_millis(400));
-        signal(&child, name);
-        let out = wait(child, 5);
         assert_eq!(out.status.code(), Some(128 + number), "SIG{name}: {out:?}");
         let e = stderr(&out);
         assert!(e.contains(&format!("interrupted by SIG{name}")), "{e}");
         assert!(e.contains("turn was sent and cancelled"), "{e}");
         let (board, heard) = board.finish();
         assert_stopped(&board, &heard);
-        let turns: Vec<i32> = harness::commands(&heard)
-            .iter()
-            .filter_map(|c| match c {
-                Command::Turn(t) => Some(t.deci_degrees),
-                _ => None,
-            })
-            .collect();
+        let turns = harness::turns(&harness::commands(&heard));
         assert_eq!(turns.len(), 2, "the turn and its cancel: {turns:?}");
         assert!(turns[1] < 0 && turns[1] > -3_600, "{turns:?}");
         println!(
@@ -109,13 +101,7 @@ fn a_turn_is_never_sent_on_top_of_one_pending() {
     let said = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(said.contains("was cancelled"), "{said}");
     let (board, heard) = board.finish();
-    let turns: Vec<i32> = harness::commands(&heard)
-        .iter()
-        .filter_map(|c| match c {
-            Command::Turn(t) => Some(t.deci_degrees),
-            _ => None,
-        })
-        .collect();
+    let turns = harness::turns(&harness::commands(&heard));
     assert_eq!(turns.first(), Some(&3_600), "{turns:?}");
     assert_eq!(
         turns.len(),
@@ -296,18 +282,7 @@ fn input_buffered_before_the_port_opens_is_not_read_as_new() {
 fn the_simulated_board_serves_on_with_nobody_reading() {
     // `chassis sim --pty`, nobody opens it for 14 s (its pseudo-terminal fills up in about
     // 11 s), then a read is answered.
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_chassis"))
-        .args(["sim", "--pty"])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    std::io::BufRead::read_line(
-        &mut std::io::BufReader::new(child.stdout.take().unwrap()),
-        &mut line,
-    )
-    .unwrap();
+    let (mut child, line) = harness::sim_pty(&[]);
     let start = Instant::now();
     while start.elapsed() < Duration::from_secs(14) {
         assert!(

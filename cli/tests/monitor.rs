@@ -18,14 +18,7 @@ fn ys(board: &TestBoard, y: i32) -> usize {
 }
 
 fn turns(board: &TestBoard) -> Vec<i32> {
-    board
-        .commands()
-        .iter()
-        .filter_map(|c| match c {
-            Command::Turn(t) => Some(t.deci_degrees),
-            _ => None,
-        })
-        .collect()
+    harness::turns(&board.commands())
 }
 
 /// What the board was sent after the last stop frame moved it: nothing.
@@ -43,13 +36,7 @@ fn driven_after_last_stop(heard: &[u8]) -> Vec<Command> {
 #[test]
 fn after_its_failsafe_stop_the_monitor_drives_only_on_a_new_key() {
     let board = TestBoard::start();
-    let mut term = Terminal::spawn(&["--port", &board.path, "monitor", "--drive"]);
-    term.wait_for_text("LINK UP");
-    term.press(b"w");
-    board.wait_for(
-        "y = 300",
-        |c| matches!(c, Command::Velocity(v) if v.y == 300),
-    );
+    let mut term = board.monitor_driving(b"w", harness::forward(300));
 
     // The board goes quiet with the key's velocity being re-sent.
     board.go_silent(true);
@@ -100,13 +87,7 @@ fn after_its_failsafe_stop_the_monitor_drives_only_on_a_new_key() {
 #[test]
 fn the_monitor_turn_ends_and_speed_keys_apply_at_once() {
     let board = TestBoard::start();
-    let mut term = Terminal::spawn(&["--port", &board.path, "monitor", "--drive"]);
-    term.wait_for_text("LINK UP");
-    term.press(b"w");
-    board.wait_for(
-        "y = 300",
-        |c| matches!(c, Command::Velocity(v) if v.y == 300),
-    );
+    let mut term = board.monitor_driving(b"w", harness::forward(300));
     term.press(b"+");
     board.wait_for(
         "y = 350 after +",
@@ -148,13 +129,8 @@ fn the_monitor_turn_ends_and_speed_keys_apply_at_once() {
 fn every_signal_stops_a_driving_monitor() {
     for (name, number) in [("INT", 2), ("TERM", 15), ("HUP", 1)] {
         let board = TestBoard::start();
-        let mut term = Terminal::spawn(&["--port", &board.path, "monitor", "--drive"]);
-        term.wait_for_text("LINK UP");
-        term.press(b"d");
-        board.wait_for(
-            "x = 300",
-            |c| matches!(c, Command::Velocity(v) if v.x == 300),
-        );
+        let mut term =
+            board.monitor_driving(b"d", |c| matches!(c, Command::Velocity(v) if v.x == 300));
         signal(&term.child, name);
         let status = term.wait(5);
         assert_eq!(status.code(), Some(128 + number), "SIG{name}");

@@ -419,3 +419,66 @@ pub fn no_replies() -> Faults {
         ..Faults::default()
     }
 }
+
+/// The angles of the turns in `commands`, in 0.1°.
+pub fn turns(commands: &[Command]) -> Vec<i32> {
+    commands
+        .iter()
+        .filter_map(|c| match c {
+            Command::Turn(t) => Some(t.deci_degrees),
+            _ => None,
+        })
+        .collect()
+}
+
+/// A velocity command with this Y (forward).
+pub fn forward(y: i32) -> impl Fn(&Command) -> bool {
+    move |c| matches!(c, Command::Velocity(v) if v.y == y)
+}
+
+impl TestBoard {
+    /// `chassis args`, started; once the board was sent what `want` accepts and `delay_ms`
+    /// more have passed, `signal` ("INT"…) is sent; the command's end.
+    pub fn signal_mid(
+        &self,
+        args: &[&str],
+        what: &str,
+        want: impl Fn(&Command) -> bool,
+        delay_ms: u64,
+        signal_name: &str,
+    ) -> Output {
+        let child = self.spawn(args);
+        self.wait_for(what, want);
+        std::thread::sleep(Duration::from_millis(delay_ms));
+        signal(&child, signal_name);
+        wait(child, 10)
+    }
+
+    /// `chassis monitor --drive` on this board in a terminal, the link up, `key` pressed and
+    /// the board driven at Y = 300.
+    pub fn monitor_driving(&self, key: &[u8], want: impl Fn(&Command) -> bool) -> Terminal {
+        let mut term = Terminal::spawn(&["--port", &self.path, "monitor", "--drive"]);
+        term.wait_for_text("LINK UP");
+        term.press(key);
+        self.wait_for("the key's velocity", want);
+        term
+    }
+}
+
+/// `chassis sim --pty EXTRA…` in the background: the process and the path it serves.
+pub fn sim_pty(extra: &[&str]) -> (Child, String) {
+    let mut child = Process::new(env!("CARGO_BIN_EXE_chassis"))
+        .args(["sim", "--pty"])
+        .args(extra)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut path = String::new();
+    std::io::BufRead::read_line(
+        &mut std::io::BufReader::new(child.stdout.take().unwrap()),
+        &mut path,
+    )
+    .unwrap();
+    (child, path.trim().to_string())
+}
