@@ -213,8 +213,22 @@ pub enum Note {
     Start(Check),
     /// A check passed.
     Passed(Check),
-    /// A check is skipped (no motion, or nothing to do).
-    Skipped(Check),
+    /// A check is skipped, and why.
+    Skipped(Check, Skip),
+}
+
+/// Why a check is skipped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Skip {
+    /// [`Plan::motion`] is `false`.
+    NoMotion,
+    /// [`Plan::drive`] is `None`: the board's drive type is kept.
+    DriveTypeKept,
+    /// A differential chassis does not move sideways (X is unused).
+    NoSideways,
+    /// A chassis without encoders (open-loop differential): nothing to count.
+    NoEncoders,
 }
 
 /// Why a check failed.
@@ -306,8 +320,11 @@ pub async fn bring_up<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Fail
     let result = steps(link, plan).await;
     if let Err(failure) = &result {
         log!(error, "bring-up: {} failed: {}", failure.check, failure.why);
-        if let Err(e) = link.stop().await {
-            log!(error, "stop after the failure: {}", e);
+        // Without motion nothing was set moving: nothing but reads is sent.
+        if plan.motion {
+            if let Err(e) = link.stop().await {
+                log!(error, "stop after the failure: {}", e);
+            }
         }
     }
     result
@@ -416,6 +433,15 @@ async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
     link.note(Note::Passed(Check::Settings));
 
     let failsafe_before = link.core().failsafe_stops();
+    if plan.motion && report.pending_before.unsigned_abs() > 10 {
+        // A turn left pending (by a program that was killed): cancelled before anything moves.
+        log!(
+            warn,
+            "[settings] a turn of {} (0.1°) was pending: cancelled",
+            report.pending_before
+        );
+        link.stop().await.map_err(fail(Check::Settings))?;
+    }
     if plan.motion {
         motion_checks(link, plan, &snapshot, &mut report, failsafe_before).await?;
     } else {
@@ -426,7 +452,7 @@ async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
             Check::Turn,
             Check::Stop,
         ] {
-            link.note(Note::Skipped(check));
+            link.note(Note::Skipped(check, Skip::NoMotion));
         }
     }
 
@@ -442,7 +468,7 @@ async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
         control_loop(link, plan, &mut report, failsafe_before).await?;
         link.note(Note::Passed(Check::ControlLoop));
     } else {
-        link.note(Note::Skipped(Check::ControlLoop));
+        link.note(Note::Skipped(Check::ControlLoop, Skip::NoMotion));
     }
 
     let missed = Stream::ALL
@@ -469,8 +495,9 @@ async fn motion_checks<L: Link>(
             "[drive-type] kept: {}",
             snapshot.system_mode.drive_type()
         );
-        link.note(Note::Skipped(Check::DriveType));
-        return moving_checks(link, plan, report, failsafe_before).await;
+        link.note(Note::Skipped(Check::DriveType, Skip::DriveTypeKept));
+        let kept = snapshot.system_mode.drive_type();
+        return moving_checks(link, plan, kept, report, failsafe_before).await;
     };
     link.note(Note::Start(Check::DriveType));
     if snapshot.system_mode.drive_type() == drive {
@@ -499,7 +526,7 @@ async fn motion_checks<L: Link>(
         );
     }
     link.note(Note::Passed(Check::DriveType));
-    moving_checks(link, plan, report, failsafe_before).await
+    moving_checks(link, plan, drive, report, failsafe_before).await
 }
 
 /// Checks 4 to 6: forward, sideways, the turn, the stop.
@@ -507,6 +534,7 @@ async fn motion_checks<L: Link>(
 async fn moving_checks<L: Link>(
     link: &mut L,
     plan: &Plan,
+    drive: DriveType,
     report: &mut Report,
     failsafe_before: u32,
 ) -> Result<(), Failure> {
@@ -515,6 +543,16 @@ async fn moving_checks<L: Link>(
         (Check::Forward, Velocity::new(0, plan.speed, 0), 0usize),
         (Check::Strafe, Velocity::new(plan.speed, 0, 0), 1),
     ] {
+        // A differential chassis has no sideways (X unused); without encoders nothing counts.
+        let skip = match drive {
+            DriveType::DifferentialOpenLoop => Some(Skip::NoEncoders),
+            DriveType::Differential if check == Check::Strafe => Some(Skip::NoSideways),
+            _ => None,
+        };
+        if let Some(why) = skip {
+            link.note(Note::Skipped(check, why));
+            continue;
+        }
         link.note(Note::Start(check));
         let moved = drive_for(link, plan, velocity, plan.drive_ms, check).await?;
         if link.core().failsafe_stops() != failsafe_before {
@@ -546,6 +584,7 @@ async fn moving_checks<L: Link>(
     let start = link.now_ms();
     let mut next_read = start.saturating_add(200);
     let mut gyro_peak = 0u16;
+    let mut pending = plan.turn_deci_degrees;
     loop {
         if link.core().failsafe_stops() != failsafe_before {
             return Err(Failure {
@@ -561,7 +600,15 @@ async fn moving_checks<L: Link>(
         }
         if now >= next_read {
             next_read = now.saturating_add(200);
-            let pending = link.turn_remaining().await.map_err(fail(Check::Turn))?;
+            // A reply lost on the line is read again at the next turn of the loop; the
+            // timeout bounds the wait. The transport failing ends the check.
+            match link.turn_remaining().await {
+                Ok(left) => pending = left,
+                Err(e @ chassis_protocol::driver::Error::Core(_)) => {
+                    log!(warn, "[turn] pending angle unread: {}", e);
+                }
+                Err(e) => return Err(fail(Check::Turn)(e)),
+            }
             if pending.unsigned_abs() <= 10 {
                 break;
             }
@@ -590,6 +637,11 @@ async fn moving_checks<L: Link>(
     link.note(Note::Passed(Check::Turn));
 
     // 6. Stop: the encoders stand still (after 100 ms to settle).
+    if drive == DriveType::DifferentialOpenLoop {
+        link.stop().await.map_err(fail(Check::Stop))?;
+        link.note(Note::Skipped(Check::Stop, Skip::NoEncoders));
+        return Ok(());
+    }
     link.note(Note::Start(Check::Stop));
     link.stop().await.map_err(fail(Check::Stop))?;
     let _ = drive_for(link, plan, Velocity::new(0, 0, 0), 100, Check::Stop).await?;

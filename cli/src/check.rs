@@ -9,7 +9,7 @@ use crate::names::register_name;
 use crate::port::{self, Board, Port, SharedClock};
 use crate::signals;
 use chassis_bringup::link::Blocking;
-use chassis_bringup::{Check, Failure, Link, LinkError, Note, Plan, Report, Why, bring_up};
+use chassis_bringup::{Check, Failure, Link, LinkError, Note, Plan, Report, Skip, Why, bring_up};
 use chassis_protocol::driver::{CoreError, DriverCore, Error, Event};
 use chassis_protocol::registers::Snapshot;
 use chassis_protocol::{DriveType, Register, Stream, Turn, Velocity, Write};
@@ -27,8 +27,10 @@ struct Checker {
     step: Instant,
     /// The checks done: passed (with what they measured) or skipped.
     done: Vec<(Check, Option<String>)>,
-    /// The plan lets the chassis move.
-    motion: bool,
+    /// How the last stop went (`None`: none was sent).
+    last_stop: Option<Result<(), LinkError>>,
+    /// The check under way.
+    current: Option<Check>,
 }
 
 impl Checker {
@@ -88,7 +90,9 @@ impl Link for Checker {
     }
     fn stop(&mut self) -> Result<(), LinkError> {
         // Never refused: a signal is what a stop is for.
-        self.inner.stop()
+        let result = self.inner.stop();
+        self.last_stop = Some(result);
+        result
     }
     fn turn(&mut self, turn: Turn) -> Result<(), LinkError> {
         self.go_on()?;
@@ -116,6 +120,7 @@ impl Link for Checker {
         match note {
             Note::Start(check) => {
                 self.step = Instant::now();
+                self.current = Some(check);
                 let _ = write!(out, "[{}/9] {:<13}", index(check), check.name());
             }
             Note::Passed(check) => {
@@ -126,17 +131,19 @@ impl Link for Checker {
                     self.step.elapsed().as_secs_f64(),
                 );
                 self.done.push((check, Some(detail)));
+                self.current = None;
             }
-            Note::Skipped(check) => {
+            Note::Skipped(check, why) => {
                 let _ = writeln!(
                     out,
-                    "[{}/9] {:<13}skipped{}",
+                    "[{}/9] {:<13}skipped ({})",
                     index(check),
                     check.name(),
-                    if !self.motion {
-                        " (--no-motion)"
-                    } else {
-                        " (the board's own kept: --drive-type sets one)"
+                    match why {
+                        Skip::NoMotion => "--no-motion",
+                        Skip::DriveTypeKept => "the board's own kept: --drive-type sets one",
+                        Skip::NoSideways => "a differential chassis does not move sideways",
+                        Skip::NoEncoders => "no encoders on an open-loop differential chassis",
                     }
                 );
                 self.done.push((check, None));
@@ -164,6 +171,9 @@ fn why(failure: &Failure, heard: bool) -> String {
         Why::Driver(Error::Core(CoreError::Unconfirmed(r))) => format!(
             "the read of {} was not confirmed (replies missing or disagreeing)",
             register_name(r)
+        ),
+        Why::Driver(Error::Transport(kind)) => format!(
+            "the serial port failed ({kind:?}): was the adapter unplugged, or the board's power cut?"
         ),
         Why::Driver(e) => format!("the driver failed: {e:?}"),
         Why::Rate(stream, per_10s) if !heard => format!(
@@ -271,7 +281,7 @@ fn confirm(path: &str) -> Result<bool, String> {
             "{MOTION}. Nobody is at a terminal to agree: add --yes to go ahead, or --no-motion to check the link, the registers and the battery only"
         ));
     }
-    eprint!("chassis check on {path}: {MOTION}.\nGo ahead? [y/N] ");
+    tell_partial!("chassis check on {path}: {MOTION}.\nGo ahead? [y/N] ");
     let _ = std::io::stderr().flush();
     let mut answer = String::new();
     stdin
@@ -302,12 +312,13 @@ pub fn check(
         start: Instant::now(),
         step: Instant::now(),
         done: Vec::new(),
-        motion: !no_motion,
+        last_stop: None,
+        current: None,
     };
-    println!(
+    say!(
         "chassis check on {path}: {}",
         if no_motion {
-            "link, registers and battery (nothing moves, nothing is written)"
+            "link, registers and battery (only reads are sent: nothing moves, nothing is written)"
         } else {
             "every check (the chassis moves)"
         }
@@ -321,17 +332,28 @@ pub fn check(
     let seconds = link.start.elapsed().as_secs_f64();
     match result {
         Ok(report) => {
-            println!("\n{}", verdict(&report, &link.done, !no_motion, seconds));
+            say!("\n{}", verdict(&report, &link.done, !no_motion, seconds));
             Ok(())
         }
         Err(failure) => {
-            // The bring-up has stopped the chassis (and cancelled a turn).
-            println!("FAILED");
+            let interrupted = signals::caught();
+            if link.current.is_some() {
+                say!(
+                    "{}",
+                    if interrupted.is_some() {
+                        "interrupted"
+                    } else {
+                        "FAILED"
+                    }
+                );
+            }
             let heard = link.core().last_heard_ms().is_some();
             let code = u8::try_from(failure.check.exit_code()).unwrap_or(1);
+            // The checks that would have run after it (not those a --no-motion run skips).
             let not_run: Vec<&str> = Check::ALL
                 .iter()
                 .filter(|c| !link.done.iter().any(|(d, _)| d == *c) && **c != failure.check)
+                .filter(|c| !no_motion || !c.moves())
                 .map(|c| c.name())
                 .collect();
             let tail = if not_run.is_empty() {
@@ -339,10 +361,26 @@ pub fn check(
             } else {
                 format!("; not run: {}", not_run.join(", "))
             };
-            match signals::caught() {
+            // What the bring-up's stop after the failure did.
+            let stopped = match (&link.last_stop, no_motion) {
+                (_, true) => String::new(),
+                (Some(Ok(())), false) => "; the chassis was stopped".into(),
+                (Some(Err(e)), false) => format!(
+                    "; the stop could not be sent ({}): the chassis may still be moving, cut its power",
+                    why(
+                        &Failure {
+                            check: failure.check,
+                            why: Why::Driver(*e)
+                        },
+                        heard
+                    )
+                ),
+                (None, false) => "; nothing had moved".into(),
+            };
+            match interrupted {
                 Some(signal) => Err((
                     format!(
-                        "interrupted by {} during the {} check: the chassis was stopped{tail}",
+                        "interrupted by {} during the {} check{stopped}{tail}",
                         signals::name(signal),
                         failure.check.name()
                     ),
@@ -350,7 +388,7 @@ pub fn check(
                 )),
                 None => Err((
                     format!(
-                        "FAIL: {}: {}; the chassis was stopped{tail}",
+                        "FAIL: {}: {}{stopped}{tail}",
                         failure.check.name(),
                         why(&failure, heard)
                     ),

@@ -7,6 +7,7 @@
 
 use crate::encode::write_of;
 use crate::names::{RegisterName, register_name};
+use crate::newfile::NewFile;
 use crate::port::{self, Board};
 use crate::signals;
 use chassis_protocol::driver::host::SerialError;
@@ -96,7 +97,7 @@ pub fn show(register: Register, raw: u32) -> String {
 pub fn get(port: &str, register: RegisterName) -> Result<(), String> {
     let mut driver = open(port)?;
     let raw = read(&mut driver, register.register())?;
-    println!("{}: {}", register.name(), show(register.register(), raw));
+    say!("{}: {}", register.name(), show(register.register(), raw));
     Ok(())
 }
 
@@ -136,7 +137,7 @@ pub fn set(
     }
     driver.write(write).map_err(|e| explain(&driver, e))?;
     if calibrates {
-        eprintln!("gyro calibration started: {CALIBRATION}");
+        tell!("gyro calibration started: {CALIBRATION}");
     }
     let back = read(&mut driver, register.register()).map_err(|e| {
         format!(
@@ -153,10 +154,15 @@ pub fn set(
             show(register.register(), back)
         ));
     }
-    println!(
-        "{}: {} (read back; `chassis save` keeps it over a power cycle)",
+    say!(
+        "{}: {} (read back; `chassis save` keeps it over a power cycle{})",
         register.name(),
-        show(register.register(), back)
+        show(register.register(), back),
+        if register.register() == Register::SystemMode {
+            ", all but bit 3, gyro compensation, which the board never stores"
+        } else {
+            ""
+        }
     );
     Ok(())
 }
@@ -234,27 +240,24 @@ pub fn settings(port: &str, save: Option<&str>, restore: Option<&str>) -> Result
                 serde_json::to_string(&board).unwrap_or_default()
             ));
         }
-        eprintln!("{}", restored(file, &snapshot, &board));
+        tell!("{}", restored(file, &snapshot, &board));
         return Ok(());
     }
-    // A file that cannot be written fails before the board is asked anything.
-    let mut out = match save {
-        Some(file) => Some((
-            file,
-            std::fs::File::create(file).map_err(|e| format!("cannot write {file}: {e}"))?,
-        )),
-        None => None,
-    };
+    // A file that cannot be written fails before the board is asked anything; what was at
+    // the path stays until the new settings are complete.
+    let out = save.map(NewFile::create).transpose()?;
     let mut driver = open(port)?;
     let snapshot = driver.read_settings().map_err(|e| explain(&driver, e))?;
     let json = serde_json::to_string_pretty(&snapshot).map_err(|e| e.to_string())?;
-    match out.as_mut() {
-        Some((file, f)) => {
+    match out {
+        Some(mut file) => {
             use std::io::Write as _;
-            writeln!(f, "{json}").map_err(|e| format!("cannot write {file}: {e}"))?;
-            eprintln!("saved to {file}");
+            let path = file.path().to_string();
+            writeln!(file, "{json}").map_err(|e| format!("cannot write {path}: {e}"))?;
+            file.commit()?;
+            tell!("saved to {path}");
         }
-        None => println!("{json}"),
+        None => say!("{json}"),
     }
     Ok(())
 }
@@ -265,7 +268,7 @@ pub fn save(port: &str) -> Result<(), String> {
     driver
         .action(Action::Store)
         .map_err(|e| explain(&driver, e))?;
-    println!("settings stored in the board's flash");
+    say!("settings stored in the board's flash");
     Ok(())
 }
 
@@ -286,7 +289,7 @@ pub fn calibrate_gyro(port: &str) -> Result<(), String> {
     driver
         .action(Action::RecalibrateGyro)
         .map_err(|e| explain(&driver, e))?;
-    eprintln!(
+    tell!(
         "gyro calibration started (30 s): put the chassis down now; from 10 s on, do not move or touch it"
     );
     let bar = indicatif::ProgressBar::new(30);
@@ -308,7 +311,7 @@ pub fn calibrate_gyro(port: &str) -> Result<(), String> {
     }
     bar.finish_and_clear();
     let value = read(&mut driver, Register::GyroCalibration)?;
-    println!("gyro calibration value: {value} (`chassis save` keeps it)");
+    say!("gyro calibration value: {value} (`chassis save` keeps it)");
     Ok(())
 }
 
@@ -358,12 +361,12 @@ pub fn stop(port: &str) -> Result<(), String> {
     match (pending, stopped) {
         (Ok(left), Ok(())) if driver.core().turn_state() == TurnState::Idle => {
             if left.unsigned_abs() > 5 {
-                println!(
+                say!(
                     "stopped; the {:.1}° turn the board had pending was cancelled",
                     f64::from(left) / 10.0
                 );
             } else {
-                println!("stopped (no turn was pending)");
+                say!("stopped (no turn was pending)");
             }
             Ok(())
         }
@@ -383,6 +386,8 @@ pub fn drive(port: &str, velocity: Velocity, seconds: f64) -> Result<(), String>
     if !(0.0..=600.0).contains(&seconds) {
         return Err(format!("--for: {seconds} s is out of range (0..=600)"));
     }
+    // -0 is 0.
+    let seconds = seconds + 0.0;
     signals::install()?;
     let mut driver = open(port)?;
     let start = Instant::now();
@@ -405,9 +410,13 @@ pub fn drive(port: &str, velocity: Velocity, seconds: f64) -> Result<(), String>
             }
             poll_for(&mut driver, 5)?;
             if driver.core().failsafe_stops() > 0 {
-                return Err(
-                    "the board went quiet while driving: the driver's failsafe stopped it".into(),
-                );
+                return Err(if driver.core().last_heard_ms().is_none() {
+                    format!(
+                        "nothing came from the board on {port} (is it powered, TX wired to RX and RX to TX, at 115200 bps?): the driver's failsafe stopped it"
+                    )
+                } else {
+                    "the board went quiet while driving: the driver's failsafe stopped it".into()
+                });
             }
             let done = start.elapsed().as_secs_f64().min(seconds);
             bar.set_position((done * 10.0) as u64);
@@ -416,7 +425,7 @@ pub fn drive(port: &str, velocity: Velocity, seconds: f64) -> Result<(), String>
         Ok(format!("drove {seconds} s, stopped"))
     })();
     bar.finish_and_clear();
-    println!("{}", stop_after(&mut driver, ended)?);
+    say!("{}", stop_after(&mut driver, ended)?);
     Ok(())
 }
 
@@ -514,6 +523,6 @@ pub fn turn(port: &str, degrees: f64) -> Result<(), String> {
         }
     };
     bar.finish_and_clear();
-    println!("{}", stop_after(&mut driver, ended)?);
+    say!("{}", stop_after(&mut driver, ended)?);
     Ok(())
 }

@@ -3,12 +3,41 @@
 //! (a missing port, a file that is not there, odd hex, a value out of range, a silent board)
 //! is one line on stderr and a non-zero exit.
 
+/// `println!` that never panics: a closed pipe (`| head`) or a full disk on standard output
+/// must not end a command that may be driving the chassis. The command goes on, and its exit
+/// status stands.
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($t)*);
+    }};
+}
+
+/// `eprintln!` that never panics (as [`say!`]).
+macro_rules! tell {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($t)*);
+    }};
+}
+
+/// `eprint!` that never panics, flushed (a question before an answer).
+macro_rules! tell_partial {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let mut err = std::io::stderr();
+        let _ = write!(err, $($t)*);
+        let _ = err.flush();
+    }};
+}
+
 mod check;
 mod decode;
 mod device;
 mod encode;
 mod monitor;
 mod names;
+mod newfile;
 mod port;
 mod record;
 mod signals;
@@ -145,7 +174,7 @@ enum Cmd {
         #[arg(long)]
         yes: bool,
         /// Set this drive type on the board (the board's own is kept if not given).
-        #[arg(long, value_enum, value_name = "TYPE")]
+        #[arg(long, value_enum, value_name = "TYPE", conflicts_with = "no_motion")]
         drive_type: Option<DriveTypeName>,
     },
     /// Capture what the board sends, time-stamped, into a file `chassis decode --input
@@ -202,63 +231,103 @@ impl DriveTypeName {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    if let Cmd::Check {
-        no_motion,
-        yes,
-        drive_type,
-    } = cli.command
-    {
-        let result = port(cli.port.as_deref())
+    let result = options(&cli).and_then(|()| match cli.command {
+        Cmd::Check {
+            no_motion,
+            yes,
+            drive_type,
+        } => port(cli.port.as_deref())
             .map_err(|e| (e, 1))
             .and_then(|path| {
-                if let Some(file) = &cli.record {
-                    port::record_to(file).map_err(|e| (e, 1))?;
-                }
                 check::check(
                     path,
                     no_motion,
                     yes,
                     drive_type.map(DriveTypeName::drive_type),
                 )
-            });
-        return match result {
-            Ok(()) => ExitCode::SUCCESS,
-            Err((message, code)) => {
-                eprintln!("chassis: {message}");
-                ExitCode::from(code)
-            }
-        };
-    }
-    match run(cli) {
+            }),
+        // A signal the command caught (and stopped the chassis for): 128 + its number, as a
+        // shell reports a process the signal ended.
+        _ => run(cli).map_err(|e| (e, signals::caught().map_or(1, signals::exit_status))),
+    });
+    // A `--record` file never attached to a port is thrown away (what was there stays); one
+    // that could not be written fails the command.
+    port::discard_unused_recording();
+    let result = match (result, port::record_error()) {
+        (Ok(()), Some(e)) => Err((e, 1)),
+        (Err((message, code)), Some(e)) => Err((format!("{message}; {e}"), code)),
+        (result, None) => result,
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(message) => {
-            eprintln!("chassis: {message}");
-            // A signal the command caught (and stopped the chassis for): 128 + its number, as
-            // a shell reports a process the signal ended.
-            signals::caught().map_or(ExitCode::FAILURE, |s| {
-                ExitCode::from(signals::exit_status(s))
-            })
+        Err((message, code)) => {
+            tell!("chassis: {message}");
+            ExitCode::from(code)
         }
     }
+}
+
+/// The global options that only some commands take: refused where they mean nothing, and
+/// `--record` armed.
+fn options(cli: &Cli) -> Result<(), (String, u8)> {
+    let (name, talks) = match cli.command {
+        Cmd::Decode { .. } => ("decode", false),
+        Cmd::Encode { .. } => ("encode", false),
+        Cmd::Sim { .. } => ("sim", false),
+        Cmd::Record { .. } => ("record", true),
+        _ => ("", true),
+    };
+    if !talks && cli.port.is_some() {
+        return Err((
+            format!("{name} talks to no board: --port is for the commands that do"),
+            2,
+        ));
+    }
+    if let Some(file) = &cli.record {
+        if !talks {
+            return Err((
+                format!("{name} talks to no board: --record FILE is for the commands that do"),
+                2,
+            ));
+        }
+        if name == "record" {
+            return Err((
+                "record: give the file with --out FILE (--record is for the other commands)".into(),
+                2,
+            ));
+        }
+        port::record_to(file).map_err(|e| (e, 1))?;
+    }
+    Ok(())
 }
 
 /// Writes the frames found, one per line, and the summary on stderr.
 fn write_decoded(decoded: &decode::Decoded, format: decode::Format) -> Result<(), String> {
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
+    let mut written = Ok(());
     for found in &decoded.frames {
         let line = match format {
             decode::Format::Json => found.json.to_string(),
             decode::Format::Text => found.text.clone(),
         };
-        if writeln!(out, "{line}").is_err() {
-            // A closed pipe (`| head`): stop quietly.
-            return Ok(());
+        written = writeln!(out, "{line}");
+        if written.is_err() {
+            break;
         }
     }
-    let _ = out.flush();
-    eprintln!("chassis decode: {}", decoded.summary);
-    Ok(())
+    if written.is_ok() {
+        written = out.flush();
+    }
+    match written {
+        // A closed pipe (`| head`): the reader has what it wanted.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err(format!("standard output: {e}")),
+        Ok(()) => {
+            tell!("chassis decode: {}", decoded.summary);
+            Ok(())
+        }
+    }
 }
 
 /// The bytes of `file` (`None` or "-": standard input).
@@ -281,14 +350,6 @@ fn port(cli_port: Option<&str>) -> Result<&str, String> {
 
 fn run(cli: Cli) -> Result<(), String> {
     let p = cli.port.as_deref();
-    if let Some(file) = cli.record {
-        if matches!(cli.command, Cmd::Record { .. }) {
-            return Err(
-                "record: give the file with --out FILE (--record is for the other commands)".into(),
-            );
-        }
-        port::record_to(&file)?;
-    }
     match cli.command {
         Cmd::Decode {
             file,
@@ -339,7 +400,7 @@ fn run(cli: Cli) -> Result<(), String> {
             write_decoded(&decoded, format)
         }
         Cmd::Encode { frame } => {
-            println!("{}", encode::hex(&encode::encode(&frame)?));
+            say!("{}", encode::hex(&encode::encode(&frame)?));
             Ok(())
         }
         Cmd::Get { register } => device::get(port(p)?, register),
@@ -365,7 +426,7 @@ fn run(cli: Cli) -> Result<(), String> {
             monitor::run(port(p)?, drive, speed)
         }
         // Run from `main`: its exit status is the verdict.
-        Cmd::Check { .. } => Err("check: run from main".into()),
+        Cmd::Check { .. } => Err("check: its own exit status".into()),
         Cmd::Record { out, seconds } => record::record(port(p)?, &out, seconds),
         Cmd::Sim {
             pty,

@@ -6,11 +6,11 @@
 //! ([`chassis_protocol::driver::Config::HOST`]'s `idle_ms`): the decode of a recording sees
 //! the frames the driver saw.
 
+use crate::newfile::NewFile;
 use chassis_protocol::driver::blocking::Driver;
 use chassis_protocol::driver::host::{MonotonicClock, SerialError, SerialPort};
 use chassis_protocol::driver::{Clock, Config};
 use std::cell::Cell;
-use std::fs::File;
 use std::io::{BufWriter, Write as _};
 use std::rc::Rc;
 
@@ -77,7 +77,24 @@ pub fn open(path: &str, record: Option<Recorder>) -> Result<Board, String> {
             ));
         }
     }
-    let port = SerialPort::open(path).map_err(|e| format!("cannot open {path}: {}", e.0))?;
+    let port = SerialPort::open(path).map_err(|e| {
+        // ENOTTY, EINVAL: a device that takes no serial settings (/dev/null, /dev/urandom).
+        // The serial port crate keeps the OS's words, not its number.
+        let text = e.0.to_string();
+        let not_serial = matches!(e.0.raw_os_error(), Some(25 | 22))
+            || ["typewriter", "Inappropriate ioctl", "Invalid argument"]
+                .iter()
+                .any(|w| text.contains(w));
+        if not_serial {
+            format!("cannot open {path}: not a serial port (it takes no serial settings: {text})")
+        } else {
+            format!("cannot open {path}: {text}")
+        }
+    })?;
+    let record = record.map(|mut r| {
+        r.armed = true;
+        r
+    });
     let clock = SharedClock {
         clock: MonotonicClock::new(),
         last: Rc::new(Cell::new(0)),
@@ -172,8 +189,13 @@ pub struct Counts {
 /// `board` or `master`, times in seconds of the driver's clock.
 #[derive(Debug)]
 pub struct Recorder {
-    out: BufWriter<File>,
+    /// The file until it is finished.
+    out: Option<BufWriter<NewFile>>,
     path: String,
+    /// Attached to a port that opened: the file is kept even if the command fails (a capture
+    /// of a failure is what a bug report needs). Never attached: it is thrown away, and what
+    /// was at the path stays.
+    armed: bool,
     /// When the last byte of each side started, in s.
     last: [f64; 2],
     /// The driver's clock when bytes from the board last came, in ms.
@@ -190,13 +212,13 @@ pub struct Recorder {
 impl Recorder {
     /// Creates `path` (fails at once if it cannot be written) and writes the header.
     pub fn create(path: &str) -> Result<Recorder, String> {
-        let file = File::create(path).map_err(|e| format!("cannot write {path}: {e}"))?;
-        let mut out = BufWriter::new(file);
+        let mut out = BufWriter::new(NewFile::create(path)?);
         writeln!(out, "name,type,start_time,duration,data")
             .map_err(|e| format!("cannot write {path}: {e}"))?;
         Ok(Recorder {
-            out,
+            out: Some(out),
             path: path.to_string(),
+            armed: false,
             last: [f64::NEG_INFINITY; 2],
             last_read_ms: None,
             quiet_seen: true,
@@ -267,8 +289,8 @@ impl Recorder {
         };
         let mut t = first.max(*last + BYTE_S).max(0.0);
         for byte in bytes {
-            if self.error.is_none() {
-                if let Err(e) = writeln!(self.out, "{name},data,{t:.7},{BYTE_S:.7},0x{byte:02X}") {
+            if let (None, Some(out)) = (&self.error, self.out.as_mut()) {
+                if let Err(e) = writeln!(out, "{name},data,{t:.7},{BYTE_S:.7},0x{byte:02X}") {
                     self.error = Some(format!("cannot write {}: {e}", self.path));
                 }
             }
@@ -279,13 +301,49 @@ impl Recorder {
 
     /// Flushes the file: the counts, or the first error writing it.
     pub fn finish(&mut self) -> Result<Counts, String> {
-        if let Err(e) = self.out.flush() {
-            self.error
-                .get_or_insert(format!("cannot write {}: {e}", self.path));
+        if let Some(out) = self.out.take() {
+            let committed = out
+                .into_inner()
+                .map_err(|e| format!("cannot write {}: {}", self.path, e.error()))
+                .and_then(NewFile::commit);
+            if let Err(e) = committed {
+                self.error.get_or_insert(e);
+            }
         }
         match &self.error {
             Some(e) => Err(e.clone()),
             None => Ok(self.counts),
+        }
+    }
+}
+
+/// The first error of a recording finished on its own (when its command ended): `main`
+/// reports it.
+static RECORD_ERROR: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
+/// Drops a `--record` recording no port took (its partial file is removed, what was at its
+/// path stays).
+pub fn discard_unused_recording() {
+    if let Ok(mut slot) = RECORD.lock() {
+        slot.take();
+    }
+}
+
+/// A recording's error, if one ended with one.
+pub fn record_error() -> Option<String> {
+    RECORD_ERROR.lock().ok().and_then(|mut e| e.take())
+}
+
+impl Drop for Recorder {
+    fn drop(&mut self) {
+        // Never attached, or finished (and its error given) already.
+        if !self.armed || self.out.is_none() {
+            return;
+        }
+        if let Err(e) = self.finish() {
+            if let Ok(mut slot) = RECORD_ERROR.lock() {
+                slot.get_or_insert(e);
+            }
         }
     }
 }

@@ -13,7 +13,9 @@ use std::time::{Duration, Instant};
 pub fn record(path: &str, out: &str, seconds: Option<f64>) -> Result<(), String> {
     if let Some(s) = seconds {
         if !(s > 0.0 && s <= 86_400.0) {
-            return Err(format!("--for: {s} s is out of range (0..=86400)"));
+            return Err(format!(
+                "--for: {s} s is out of range (more than 0, up to 86400)"
+            ));
         }
     }
     signals::install()?;
@@ -66,11 +68,11 @@ pub fn record(path: &str, out: &str, seconds: Option<f64>) -> Result<(), String>
         Some(e) => Err(format!("{e} (what came before is in {out}: {summary})")),
         None => {
             if counts.board_bytes == 0 {
-                eprintln!(
+                tell!(
                     "chassis record: nothing came from the board (is it powered, TX wired to RX, at 115200 bps?)"
                 );
             }
-            println!("{summary}");
+            say!("{summary}");
             Ok(())
         }
     }

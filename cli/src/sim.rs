@@ -41,8 +41,8 @@ pub fn pty(seed: u64, faults: Faults) -> Result<(), String> {
         .set_timeout(std::time::Duration::from_millis(1))
         .map_err(|e| format!("pseudo-terminal: {e}"))?;
     let path = master_end.name().ok_or("the pseudo-terminal has no path")?;
-    println!("{path}");
-    eprintln!(
+    say!("{path}");
+    tell!(
         "chassis sim: a simulated board on {path} (115200 8N1); try `chassis --port {path} settings`. Ctrl-C stops it."
     );
     // The other end stays open here, so the board's end never reads an end of file while no
@@ -67,10 +67,8 @@ pub fn pty(_seed: u64, _faults: Faults) -> Result<(), String> {
 pub fn tcp(addr: &str, seed: u64, faults: Faults) -> Result<(), String> {
     let listener = TcpListener::bind(addr).map_err(|e| format!("cannot listen on {addr}: {e}"))?;
     let local = listener.local_addr().map_err(|e| format!("{addr}: {e}"))?;
-    println!("{local}");
-    eprintln!(
-        "chassis sim: a simulated board on tcp {local}, one client at a time. Ctrl-C stops it."
-    );
+    say!("{local}");
+    tell!("chassis sim: a simulated board on tcp {local}, one client at a time. Ctrl-C stops it.");
     loop {
         let (stream, peer) = listener
             .accept()
@@ -80,15 +78,15 @@ pub fn tcp(addr: &str, seed: u64, faults: Faults) -> Result<(), String> {
         stream
             .set_nonblocking(true)
             .map_err(|e| format!("{peer}: {e}"))?;
-        eprintln!("chassis sim: {peer} connected");
+        tell!("chassis sim: {peer} connected");
         let stop = AtomicBool::new(false);
         match serve(board(seed, faults), stream, &stop) {
-            Ok(board) => eprintln!(
+            Ok(board) => tell!(
                 "chassis sim: {peer} left after {:.1} s ({} commands)",
                 board.now_ms() as f64 / 1000.0,
                 board.commands()
             ),
-            Err(e) => eprintln!("chassis sim: {peer}: {e}"),
+            Err(e) => tell!("chassis sim: {peer}: {e}"),
         }
     }
 }

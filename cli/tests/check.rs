@@ -141,7 +141,7 @@ fn ctrl_c_mid_turn_cancels_it_and_stops() {
     let (stdout, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(130), "{stdout}\n{stderr}");
     assert!(
-        stderr.contains("interrupted by SIGINT during the turn check: the chassis was stopped"),
+        stderr.contains("interrupted by SIGINT during the turn check; the chassis was stopped"),
         "{stderr}"
     );
     let (board, heard) = board.finish();
@@ -175,5 +175,60 @@ fn check_passes_through_chassis_sim_with_line_faults() {
     assert!(
         stdout.contains("PASS: 8 checks passed, 1 skipped"),
         "{stdout}"
+    );
+}
+
+#[test]
+fn lost_replies_during_the_turn_do_not_fail_it() {
+    let board = TestBoard::start();
+    let child = board.spawn(&["check", "--yes"]);
+    board.wait_for("the turn", |c| matches!(c, Command::Turn(_)));
+    board.lose_pending_angle_replies(2);
+    let out = harness::wait(child, 20);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+}
+
+#[test]
+fn a_turn_left_pending_is_cancelled_before_anything_moves() {
+    // A turn of 360° the board still has (a program killed while it turned).
+    let leftover = chassis_protocol::Turn::by_deci_degrees(3_600).encode();
+    let board = TestBoard::with(|b| b.receive(&leftover));
+    let out = board.run(&["check", "--yes"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    let (board, heard) = board.finish();
+    let commands = harness::commands(&heard);
+    let cancel = commands
+        .iter()
+        .position(|c| matches!(c, Command::Turn(t) if t.deci_degrees < 0))
+        .expect("the leftover turn cancelled");
+    let first_drive = commands
+        .iter()
+        .position(harness::moves)
+        .expect("the checks drove it");
+    assert!(
+        cancel <= first_drive,
+        "cancelled before anything moved: {commands:?}"
+    );
+    assert_stopped(&board, &heard);
+}
+
+#[test]
+fn a_differential_chassis_skips_the_sideways_check() {
+    let board = TestBoard::start();
+    let out = board.run(&["check", "--yes", "--drive-type", "differential"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("strafe       skipped (a differential chassis does not move sideways)"),
+        "{stdout}"
+    );
+    let (_, heard) = board.finish();
+    assert!(
+        !harness::commands(&heard)
+            .iter()
+            .any(|c| matches!(c, Command::Velocity(v) if v.x != 0)),
+        "never told to move sideways"
     );
 }

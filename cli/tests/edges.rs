@@ -253,6 +253,21 @@ fn bad_arguments_fail_before_the_board_is_asked() {
     assert!(!stderr(&out).contains("typewriter"));
     let _ = std::fs::remove_file(&file);
 
+    let out = board.run(&["set", "battery-range", "1050", "1260"]);
+    assert_error(&out, &["not above cut-off"]);
+    let bogus = std::env::temp_dir().join(format!("chassis-bogus-{}.json", std::process::id()));
+    std::fs::write(
+        &bogus,
+        r#"{"max_speed":700,"speed_kp":300,"speed_ki":20,"gyro_gain":50000,"system_mode":1,"gyro_calibration":512,"motor_centivolts":1200,"battery_full_centivolts":32767,"battery_cutoff_centivolts":32767,"max_sped":1}"#,
+    )
+    .unwrap();
+    let out = board.run(&["settings", "--restore", &bogus.to_string_lossy()]);
+    assert_error(&out, &["not a settings file", "max_sped"]);
+    let _ = std::fs::remove_file(&bogus);
+    assert!(board.heard().is_empty(), "nothing was written or read");
+    let out = chassis(&["--port", "/dev/null", "get", "max-speed"]);
+    assert_error(&out, &["not a serial port"]);
+
     let out = board.run(&["monitor"]);
     assert_error(&out, &["terminal"]);
     assert!(!stderr(&out).contains("os error"), "{}", stderr(&out));
@@ -309,6 +324,8 @@ fn a_board_gone_quiet_mid_drive_is_stopped_and_said() {
         "y = 300",
         |c| matches!(c, Command::Velocity(v) if v.y == 300),
     );
+    // Heard for a while first (a board silent from the start is "nothing came").
+    std::thread::sleep(Duration::from_millis(300));
     board.go_silent(true);
     let out = wait(child, 5);
     assert_error(&out, &["went quiet", "failsafe stopped it"]);
@@ -425,4 +442,92 @@ fn record_flag_captures_both_sides_of_a_command() {
         "a verified read is two replies of 1000: {replies:?}"
     );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_failed_save_or_record_leaves_the_file_that_was_there() {
+    let dir = std::env::temp_dir().join(format!("chassis-keep-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let keep = |name: &str| {
+        let path = dir.join(name).to_string_lossy().into_owned();
+        std::fs::write(&path, "what was there\n").unwrap();
+        path
+    };
+    let (settings, capture, both) = (keep("s.json"), keep("c.csv"), keep("b.csv"));
+    let missing = "/dev/does-not-exist";
+    assert_error(
+        &chassis(&["--port", missing, "settings", "--save", &settings]),
+        &["cannot open"],
+    );
+    assert_error(
+        &chassis(&["--port", missing, "record", "--out", &capture]),
+        &["cannot open"],
+    );
+    assert_error(
+        &chassis(&["--port", missing, "--record", &both, "get", "max-speed"]),
+        &["cannot open"],
+    );
+    // A board that never answers: nothing to save.
+    let silent = TestBoard::start();
+    silent.go_silent(true);
+    assert_error(
+        &silent.run(&["settings", "--save", &settings]),
+        &["max-speed"],
+    );
+    for path in [&settings, &capture, &both] {
+        assert_eq!(
+            std::fs::read_to_string(path).unwrap(),
+            "what was there\n",
+            "{path}"
+        );
+    }
+    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+    assert_eq!(left.len(), 3, "no partial file left behind: {left:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn global_options_are_refused_where_they_mean_nothing() {
+    let dir = std::env::temp_dir().join(format!("chassis-global-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("in.hex").to_string_lossy().into_owned();
+    std::fs::write(&input, "FF FA").unwrap();
+    let out = chassis(&["--record", &input, "decode", &input, "--input", "hex"]);
+    assert_error(&out, &["decode talks to no board", "--record"]);
+    assert_eq!(
+        std::fs::read_to_string(&input).unwrap(),
+        "FF FA",
+        "the input is untouched"
+    );
+    assert_error(
+        &chassis(&["--port", "/dev/ttyUSB0", "encode", "read", "kp"]),
+        &["encode talks to no board", "--port"],
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_recording_that_cannot_be_written_fails_its_command() {
+    let board = TestBoard::start();
+    let out = board.run(&["--record", "/dev/full", "get", "max-speed"]);
+    assert_error(&out, &["cannot write /dev/full"]);
+}
+
+#[test]
+fn a_closed_output_pipe_neither_panics_nor_leaves_the_chassis_moving() {
+    let board = TestBoard::start();
+    let mut child = board.spawn(&["check", "--yes"]);
+    // Read the first line, then close the pipe (as `| head -1` does).
+    let mut line = String::new();
+    std::io::BufRead::read_line(
+        &mut std::io::BufReader::new(child.stdout.take().unwrap()),
+        &mut line,
+    )
+    .unwrap();
+    assert!(line.contains("chassis check on"), "{line}");
+    let out = wait(child, 30);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("panicked"), "{}", stderr(&out));
+    let (board, heard) = board.finish();
+    assert_stopped(&board, &heard);
 }

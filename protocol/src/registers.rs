@@ -10,6 +10,8 @@ use crate::telemetry::Reply;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+// A settings file with a misspelt key is refused, not half applied.
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Snapshot {
     /// `0x01`, unit not stated.
     pub max_speed: u16,
