@@ -413,7 +413,7 @@ async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
     // 2. Every register, and the pending angle.
     link.note(Note::Start(Check::Settings));
     let snapshot = link.read_settings().await.map_err(fail(Check::Settings))?;
-    report.pending_before = link.turn_remaining().await.map_err(fail(Check::Settings))?;
+    report.pending_before = pending_angle(link).await.map_err(fail(Check::Settings))?;
     report.snapshot = snapshot;
     log!(info, "[settings] {}", snapshot);
     log!(
@@ -762,6 +762,20 @@ async fn control_loop<L: Link>(
         reads
     );
     Ok(())
+}
+
+/// The angle still pending, read until a reply comes (three reads at most): one reply lost
+/// on the line is no reason to fail a check. The transport failing ends it at once.
+#[maybe_async::maybe_async]
+async fn pending_angle<L: Link>(link: &mut L) -> Result<i32, LinkError> {
+    let mut tries = 0u8;
+    loop {
+        tries = tries.saturating_add(1);
+        match link.turn_remaining().await {
+            Err(chassis_protocol::driver::Error::Core(_)) if tries < 3 => {}
+            other => return other,
+        }
+    }
 }
 
 /// What a timed drive saw.
