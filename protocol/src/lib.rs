@@ -94,6 +94,7 @@ pub mod registers;
 pub mod sim;
 pub mod telemetry;
 pub mod units;
+pub mod v1;
 mod wire;
 
 pub use bytes::FrameBytes;

@@ -432,11 +432,12 @@ fn msrv() -> Result<(), String> {
 
 /// The fuzz targets, in `host-tests/fuzz`, each with the number of runs `test` gives it (about
 /// 30 s each here).
-const FUZZ_TARGETS: [(&str, u32); 4] = [
+const FUZZ_TARGETS: [(&str, u32); 5] = [
     ("downlink", 500_000),
     ("uplink", 500_000),
     ("roundtrip", 1_000_000),
     ("spliced", 50_000),
+    ("v1", 500_000),
 ];
 
 /// proptest's seed for the runs in `test`.

@@ -3,7 +3,7 @@
 
 use chassis_host_tests::BoardStream;
 use chassis_host_tests::channel::{Noise, transmit};
-use chassis_protocol::{Command, Motors, Register, Setting, Turn, Velocity};
+use chassis_protocol::{Command, Motors, Register, Setting, Turn, Velocity, v1};
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use std::path::{Path, PathBuf};
@@ -41,6 +41,30 @@ fn seeds(dir: &Path) -> std::io::Result<usize> {
         }
         write(dir, "uplink", written, &uplink)?;
         write(dir, "roundtrip", written, &uplink[..uplink.len().min(24)])?;
+        // v1.0.0 (`7B … BCC 7D`): telemetry with replies, then commands, clean and noisy
+        // (the fuzz input is a pair: the bytes, then the slice lengths).
+        let mut v1_bytes = Vec::new();
+        for i in 0..6i16 {
+            let t = v1::Telemetry {
+                velocity: [i, n as i16, -i],
+                quaternion: [1_000, 0, 0, i],
+                battery_mv: 11_800,
+                ..v1::Telemetry::default()
+            };
+            v1_bytes.extend_from_slice(&t.encode());
+            let r = v1::Readback::ALL[(n as usize + i as usize) % 5];
+            v1_bytes.extend_from_slice(&v1::Command::Readback(r).encode());
+        }
+        v1_bytes.extend_from_slice(
+            &v1::Command::BodyVelocity(v1::BodyVelocity::new(n as i16 * 10, 300, -50)).encode(),
+        );
+        let v1_noisy = transmit(
+            &v1_bytes,
+            &Noise::mixed(1e-2),
+            &mut Pcg64Mcg::seed_from_u64(n),
+        );
+        write(dir, "v1", written, &v1_bytes)?;
+        write(dir, "v1", written + 1, &v1_noisy.bytes)?;
         written += 2;
     }
     Ok(written)
