@@ -5,12 +5,12 @@
 //! writes to the board. Before anything moves, a warning and a question (`--yes` answers it).
 //! SIGINT, SIGTERM and SIGHUP stop the chassis (a turn cancelled) and end the check.
 
-use crate::names::register_name;
+use crate::device::core_words;
 use crate::port::{self, Board, Port, SharedClock};
 use crate::signals;
 use chassis_bringup::link::Blocking;
 use chassis_bringup::{Check, Failure, Link, LinkError, Note, Plan, Report, Skip, Why, bring_up};
-use chassis_protocol::driver::{CoreError, DriverCore, Error, Event};
+use chassis_protocol::driver::{DriverCore, Error, Event};
 use chassis_protocol::registers::Snapshot;
 use chassis_protocol::{DriveType, Register, Stream, Turn, Velocity, Write};
 use std::io::{BufRead, IsTerminal, Write as _};
@@ -154,24 +154,12 @@ impl Link for Checker {
 }
 
 /// Why a check failed, in words.
-fn why(failure: &Failure, heard: bool) -> String {
+fn why(failure: &Failure, heard: bool, port: &str) -> String {
     match failure.why {
         Why::Driver(Error::Transport(embedded_io::ErrorKind::Interrupted)) => {
             "interrupted".into()
         }
-        Why::Driver(Error::Core(CoreError::Timeout(r) | CoreError::Unconfirmed(r))) if !heard => {
-            format!(
-                "nothing came from the board: no answer to the read of {} (is it powered, TX wired to RX and RX to TX, at 115200 bps?)",
-                register_name(r)
-            )
-        }
-        Why::Driver(Error::Core(CoreError::Timeout(r))) => {
-            format!("no answer to the read of {}", register_name(r))
-        }
-        Why::Driver(Error::Core(CoreError::Unconfirmed(r))) => format!(
-            "the read of {} was not confirmed (replies missing or disagreeing)",
-            register_name(r)
-        ),
+        Why::Driver(Error::Core(e)) => core_words(e, !heard, port),
         Why::Driver(Error::Transport(kind)) => format!(
             "the serial port failed ({kind:?}): was the adapter unplugged, or the board's power cut?"
         ),
@@ -372,7 +360,8 @@ pub fn check(
                             check: failure.check,
                             why: Why::Driver(*e)
                         },
-                        heard
+                        heard,
+                        path
                     )
                 ),
                 (None, false) => "; nothing had moved".into(),
@@ -390,7 +379,7 @@ pub fn check(
                     format!(
                         "FAIL: {}: {}{stopped}{tail}",
                         failure.check.name(),
-                        why(&failure, heard)
+                        why(&failure, heard, path)
                     ),
                     code,
                 )),

@@ -24,37 +24,41 @@ pub fn open(port: &str) -> Result<Board, String> {
 /// came from the board.
 pub fn explain(driver: &Board, e: Error<SerialError>) -> String {
     let port = driver.uart().name();
-    let silent = driver.core().last_heard_ms().is_none();
-    let nothing = |what: String| {
-        format!(
-            "nothing came from the board on {port}: {what} (is it powered, TX wired to RX and RX to TX, at 115200 bps?)"
-        )
-    };
     match e {
-        Error::Core(CoreError::Timeout(r) | CoreError::Unconfirmed(r)) if silent => {
-            nothing(format!("no answer to the read of {}", register_name(r)))
-        }
-        Error::Core(CoreError::Timeout(r)) => format!(
+        Error::Core(e) => core_words(e, driver.core().last_heard_ms().is_none(), port),
+        Error::Transport(e) => format!("serial port {port}: {}", e.0),
+        other => other.to_string(),
+    }
+}
+
+/// The driver's logic error `e` in the CLI's words (`silent`: nothing at all came from the
+/// board on `port`). Shared by every command and `chassis check`.
+pub fn core_words(e: CoreError, silent: bool, port: &str) -> String {
+    match e {
+        CoreError::Timeout(r) | CoreError::Unconfirmed(r) if silent => format!(
+            "nothing came from the board on {port}: no answer to the read of {} (is it powered, TX wired to RX and RX to TX, at 115200 bps?)",
+            register_name(r)
+        ),
+        CoreError::Timeout(r) => format!(
             "the board did not answer the read of {} (its telemetry arrives: a reply lost on the line?)",
             register_name(r)
         ),
-        Error::Core(CoreError::Unconfirmed(r)) => format!(
+        CoreError::Unconfirmed(r) => format!(
             "the read of {} was not confirmed: its replies went missing or disagreed, while its telemetry arrives (a noisy line?)",
             register_name(r)
         ),
-        Error::Core(CoreError::WrongReply { expected, got }) => format!(
+        CoreError::WrongReply { expected, got } => format!(
             "a reply with code {got:#04x} came while reading {}",
             register_name(expected)
         ),
-        Error::Core(CoreError::Invalid { register, value }) => format!(
+        CoreError::Invalid { register, value } => format!(
             "a damaged reply: {value:#010x} cannot be {}'s value",
             register_name(register)
         ),
-        Error::Core(CoreError::TurnInProgress) => {
+        CoreError::TurnInProgress => {
             "the board still has a turn pending (it adds turns up): `chassis stop` cancels it"
                 .into()
         }
-        Error::Transport(e) => format!("serial port {port}: {}", e.0),
         other => other.to_string(),
     }
 }
