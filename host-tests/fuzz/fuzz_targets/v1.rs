@@ -5,7 +5,7 @@
 #![no_main]
 
 use chassis_host_tests::pieces;
-use chassis_protocol::v1::{self, Command, Downlink, DownlinkParser, UplinkParser};
+use chassis_protocol::v1::{self, Command, Downlink, DownlinkParser, Parser, UplinkParser};
 use libfuzzer_sys::fuzz_target;
 
 fn contains(haystack: &[u8], needle: &[u8]) -> bool {

@@ -178,14 +178,6 @@ impl DownlinkParser {
         frame
     }
 
-    /// Every frame of `bytes`, in order.
-    pub fn frames<'p, 'b>(&'p mut self, bytes: &'b [u8]) -> Frames<'p, 'b, Self> {
-        Frames {
-            parser: self,
-            bytes,
-        }
-    }
-
     /// What it has seen.
     #[must_use]
     pub const fn stats(&self) -> Stats {
@@ -243,14 +235,6 @@ impl UplinkParser {
         self.framer.len
     }
 
-    /// Every command of `bytes`, in order.
-    pub fn frames<'p, 'b>(&'p mut self, bytes: &'b [u8]) -> Frames<'p, 'b, Self> {
-        Frames {
-            parser: self,
-            bytes,
-        }
-    }
-
     /// What it has seen.
     #[must_use]
     pub const fn stats(&self) -> Stats {
@@ -266,6 +250,17 @@ pub trait Parser {
     fn push(&mut self, byte: u8) -> Option<Self::Frame>;
     /// [`DownlinkParser::poll`].
     fn poll(&mut self) -> Option<Self::Frame>;
+
+    /// Every frame of `bytes`, in order.
+    fn frames<'p, 'b>(&'p mut self, bytes: &'b [u8]) -> Frames<'p, 'b, Self>
+    where
+        Self: Sized,
+    {
+        Frames {
+            parser: self,
+            bytes,
+        }
+    }
 }
 
 impl Parser for DownlinkParser {
@@ -288,7 +283,7 @@ impl Parser for UplinkParser {
     }
 }
 
-/// The frames of a slice, in order ([`DownlinkParser::frames`], [`UplinkParser::frames`]).
+/// The frames of a slice, in order ([`Parser::frames`]).
 #[derive(Debug)]
 pub struct Frames<'p, 'b, P> {
     parser: &'p mut P,
