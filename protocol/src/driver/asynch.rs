@@ -25,7 +25,7 @@
 //! The UART's `write` must take no byte when its future is dropped before it completes, as
 //! embassy's `BufferedUart` (and any write that copies into a buffer on its first poll) does.
 
-use super::{Clock, Config, CoreError, DriverCore, Error, Event, Outcome, Readable, Request};
+use super::{Clock, Config, Core, CoreError, DriverCore, Error, Outcome, Readable, Request, v1};
 use crate::command::{Action, Motors, Register, Turn, Velocity, Write};
 use crate::registers::Snapshot;
 use embassy_futures::select::{Either, select};
@@ -39,25 +39,26 @@ pub const MAX_WAIT_MS: u64 = 10;
 /// before a request gives up with [`CoreError::ClockStalled`].
 pub const STALL_WAITS: u32 = 10_000;
 
-/// The async driver: owns the UART, the clock and the delay. Everything it knows is in its
-/// [`DriverCore`] ([`release`](Driver::release) gives it back, [`from_core`](Driver::from_core)
-/// takes it again).
+/// The async driver: owns the UART, the clock and the delay. Everything it knows is in its core
+/// `K` ([`release`](Driver::release) gives it back, [`from_core`](Driver::from_core) takes it
+/// again): [`DriverCore`] for the 2020 firmware ([`Driver::new`]), [`v1::DriverCore`] for
+/// v1.0.0 ([`Driver::new_v1`]), one pump and one cancellation policy for both.
 #[derive(Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Driver<U, C, D> {
+pub struct Driver<U, C, D, K = DriverCore> {
     uart: U,
     clock: C,
     delay: D,
-    core: DriverCore,
+    core: K,
 }
 
 /// Ends the request in progress if its future is dropped before it finished.
-struct Running<'a, U, C, D> {
-    driver: &'a mut Driver<U, C, D>,
+struct Running<'a, U, C, D, K: Core> {
+    driver: &'a mut Driver<U, C, D, K>,
     done: bool,
 }
 
-impl<U, C, D> Drop for Running<'_, U, C, D> {
+impl<U, C, D, K: Core> Drop for Running<'_, U, C, D, K> {
     fn drop(&mut self) {
         if !self.done {
             self.driver.core.abort();
@@ -76,48 +77,6 @@ where
         Self::from_core(uart, clock, delay, DriverCore::new(config))
     }
 
-    /// A driver that goes on from `core` (what [`release`](Driver::release) gave).
-    pub const fn from_core(uart: U, clock: C, delay: D, core: DriverCore) -> Self {
-        Driver {
-            uart,
-            clock,
-            delay,
-            core,
-        }
-    }
-
-    /// Gives back the UART, the clock, the delay and the core (keep it for
-    /// [`from_core`](Driver::from_core): it holds the turn guard and a frame half sent).
-    #[must_use = "the core holds the turn guard: pass it to Driver::from_core"]
-    pub fn release(self) -> (U, C, D, DriverCore) {
-        (self.uart, self.clock, self.delay, self.core)
-    }
-
-    /// Changes the configuration, keeping everything the driver knows.
-    pub fn set_config(&mut self, config: Config) {
-        self.core.set_config(config);
-    }
-
-    /// The UART (to inspect it; the driver keeps it).
-    pub const fn uart(&self) -> &U {
-        &self.uart
-    }
-
-    /// The UART, mutably (for a test double's controls).
-    pub fn uart_mut(&mut self) -> &mut U {
-        &mut self.uart
-    }
-
-    /// The sans-IO core.
-    pub const fn core(&self) -> &DriverCore {
-        &self.core
-    }
-
-    /// The sans-IO core, mutably: [`DriverCore::abandon_turn`], [`DriverCore::abort`].
-    pub fn core_mut(&mut self) -> &mut DriverCore {
-        &mut self.core
-    }
-
     /// Sets the body velocity. Safe to call every period.
     pub async fn set_velocity(&mut self, velocity: Velocity) -> Result<(), Error<U::Error>> {
         let now = self.clock.now_ms();
@@ -132,18 +91,6 @@ where
         self.flush_out(now).await?;
         self.core.motors(motors, now)?;
         self.flush_out(now).await
-    }
-
-    /// Stops the chassis, and cancels an outstanding turn (see the blocking driver's `stop`).
-    pub async fn stop(&mut self) -> Result<(), Error<U::Error>> {
-        let now = self.clock.now_ms();
-        self.core.stop();
-        self.flush_out(now).await?;
-        if self.core.busy_for_user() {
-            self.guarded().await.map(|_| ())
-        } else {
-            Ok(())
-        }
     }
 
     /// Sends a turn once; see [`crate::driver`] for the guard. A new driver reads the pending
@@ -227,8 +174,123 @@ where
             .map(|_| ())
     }
 
-    /// Runs any [`Request`] to its end.
-    pub async fn run(&mut self, request: Request) -> Result<Outcome, Error<U::Error>> {
+    async fn value(&mut self, request: Request) -> Result<u32, Error<U::Error>> {
+        match self.run(request).await? {
+            Outcome::Value(raw) => Ok(raw),
+            _ => Ok(0),
+        }
+    }
+}
+
+impl<U, C, D> Driver<U, C, D, v1::DriverCore>
+where
+    U: Read + IoWrite,
+    C: Clock,
+    D: DelayNs,
+{
+    /// A driver for the v1.0.0 firmware (the failsafe at least [`v1::MIN_FAILSAFE_MS`]).
+    pub fn new_v1(uart: U, clock: C, delay: D, config: Config) -> Self {
+        Self::from_core(uart, clock, delay, v1::DriverCore::new(config))
+    }
+
+    /// Sets the body velocity (`0x25`, SI units × 1000). Safe to call every period.
+    pub async fn set_velocity(
+        &mut self,
+        velocity: crate::v1::BodyVelocity,
+    ) -> Result<(), Error<U::Error>> {
+        self.send(|core, now| core.velocity(velocity, now)).await
+    }
+
+    /// Drives each motor (`0x26`, the board's own unit).
+    pub async fn set_motors(
+        &mut self,
+        motors: crate::v1::MotorVelocity,
+    ) -> Result<(), Error<U::Error>> {
+        self.send(|core, now| core.motors(motors, now)).await
+    }
+
+    /// One readback: the board's reply.
+    pub async fn readback(
+        &mut self,
+        readback: crate::v1::Readback,
+    ) -> Result<crate::v1::Reply, Error<U::Error>> {
+        match self.run(v1::Request::Read(readback)).await? {
+            v1::Outcome::Reply(reply) => Ok(reply),
+            v1::Outcome::Done => Err(Error::Core(CoreError::NoReadback(readback))),
+        }
+    }
+
+    /// Writes a settings frame ([`v1::SETTINGS_GAP_MS`] after the previous one) and reads it
+    /// back: `Ok` once the board shows what was written.
+    pub async fn write_settings(&mut self, settings: v1::Settings) -> Result<(), Error<U::Error>> {
+        self.run(v1::Request::Write(settings)).await.map(|_| ())
+    }
+}
+
+impl<U, C, D, K> Driver<U, C, D, K>
+where
+    U: Read + IoWrite,
+    C: Clock,
+    D: DelayNs,
+    K: Core,
+{
+    /// A driver that goes on from `core` (what [`release`](Driver::release) gave).
+    pub const fn from_core(uart: U, clock: C, delay: D, core: K) -> Self {
+        Driver {
+            uart,
+            clock,
+            delay,
+            core,
+        }
+    }
+
+    /// Gives back the UART, the clock, the delay and the core (keep it for
+    /// [`from_core`](Driver::from_core): it holds the turn guard and a frame half sent).
+    #[must_use = "the core holds the turn guard: pass it to Driver::from_core"]
+    pub fn release(self) -> (U, C, D, K) {
+        (self.uart, self.clock, self.delay, self.core)
+    }
+
+    /// Changes the configuration, keeping everything the driver knows.
+    pub fn set_config(&mut self, config: Config) {
+        self.core.set_config(config);
+    }
+
+    /// The UART (to inspect it; the driver keeps it).
+    pub const fn uart(&self) -> &U {
+        &self.uart
+    }
+
+    /// The UART, mutably (for a test double's controls).
+    pub fn uart_mut(&mut self) -> &mut U {
+        &mut self.uart
+    }
+
+    /// The sans-IO core.
+    pub const fn core(&self) -> &K {
+        &self.core
+    }
+
+    /// The sans-IO core, mutably: [`DriverCore::abandon_turn`], [`DriverCore::abort`].
+    pub fn core_mut(&mut self) -> &mut K {
+        &mut self.core
+    }
+
+    /// Stops the chassis (the generation's stop frame) and, on the 2020 firmware, cancels an
+    /// outstanding turn (see the blocking driver's `stop`).
+    pub async fn stop(&mut self) -> Result<(), Error<U::Error>> {
+        let now = self.clock.now_ms();
+        self.core.stop();
+        self.flush_out(now).await?;
+        if self.core.busy_for_user() {
+            self.guarded().await.map(|_| ())
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Runs any request to its end.
+    pub async fn run(&mut self, request: K::Request) -> Result<K::Outcome, Error<U::Error>> {
         self.core.start(request)?;
         self.guarded().await
     }
@@ -236,7 +298,7 @@ where
     /// Waits for the next event, at most [`MAX_WAIT_MS`] (or until the core's next deadline,
     /// if sooner); `Ok(None)` if none came. Runs the quiet-line detection, reply timeouts and
     /// the failsafe on the way. Yields while it waits.
-    pub async fn poll(&mut self) -> Result<Option<Event>, Error<U::Error>> {
+    pub async fn poll(&mut self) -> Result<Option<K::Event>, Error<U::Error>> {
         let result = self.pump().await;
         if result.is_err() {
             self.core.abort();
@@ -244,16 +306,20 @@ where
         result.map(|(event, _)| event)
     }
 
-    async fn value(&mut self, request: Request) -> Result<u32, Error<U::Error>> {
-        match self.run(request).await? {
-            Outcome::Value(raw) => Ok(raw),
-            _ => Ok(0),
-        }
+    /// Finishes what is to go out, lets `queue` put a frame in the core, and sends it.
+    async fn send(
+        &mut self,
+        queue: impl FnOnce(&mut K, u64) -> Result<(), CoreError>,
+    ) -> Result<(), Error<U::Error>> {
+        let now = self.clock.now_ms();
+        self.flush_out(now).await?;
+        queue(&mut self.core, now)?;
+        self.flush_out(now).await
     }
 
     /// Pumps until the request in progress ends; if this future is dropped first, the request
     /// is ended with it.
-    async fn guarded(&mut self) -> Result<Outcome, Error<U::Error>> {
+    async fn guarded(&mut self) -> Result<K::Outcome, Error<U::Error>> {
         let mut running = Running {
             driver: self,
             done: false,
@@ -263,7 +329,7 @@ where
         result
     }
 
-    async fn finish(&mut self) -> Result<Outcome, Error<U::Error>> {
+    async fn finish(&mut self) -> Result<K::Outcome, Error<U::Error>> {
         loop {
             let now = match self.pump().await {
                 Ok((_, now)) => now,
@@ -279,7 +345,7 @@ where
     }
 
     /// One turn of the pump: the event it brought, if any, and the time it ended at.
-    async fn pump(&mut self) -> Result<(Option<Event>, u64), Error<U::Error>> {
+    async fn pump(&mut self) -> Result<(Option<K::Event>, u64), Error<U::Error>> {
         let now = self.clock.now_ms();
         self.flush_out(now).await?;
         if let Some(event) = self.core.drain(now) {

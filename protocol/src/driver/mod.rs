@@ -133,6 +133,7 @@ mod safety;
 mod sans_io;
 mod split;
 mod time;
+pub mod v1;
 
 pub use crate::registers::{BatteryRange, Readable, Snapshot, reg};
 pub use sans_io::{DriverCore, Event, Outcome, Outgoing, Request, Stamped, StreamInfo, TurnState};
@@ -152,6 +153,57 @@ impl<F: FnMut() -> u64> Clock for F {
     fn now_ms(&mut self) -> u64 {
         self()
     }
+}
+
+/// What a shell ([`blocking::Driver`], [`asynch::Driver`]) needs of a driver core: the pump
+/// (bytes out whole, bytes in, time judged) and the request in progress. One shell serves each
+/// firmware generation: [`DriverCore`] speaks the 2020 firmware (`FF FE` frames),
+/// [`v1::DriverCore`] v1.0.0 (`7B … BCC 7D`). What a generation can do (a turn by an angle, a
+/// register read) is in the methods of its own core and of `Driver<_, _, ItsCore>`: a call that
+/// means nothing to a generation does not compile for it.
+///
+/// Sealed: the two cores are the crate's.
+pub trait Core: sealed::Sealed {
+    /// Something the core saw on the line (a telemetry frame, a reply nobody waited for).
+    type Event;
+    /// A request that needs replies.
+    type Request;
+    /// How a request ended.
+    type Outcome;
+
+    /// Changes the limits, keeping everything the core knows.
+    fn set_config(&mut self, config: Config);
+    /// Starts a request ([`CoreError::Busy`] while another runs).
+    fn start(&mut self, request: Self::Request) -> Result<(), CoreError>;
+    /// Queues the stop frame ahead of everything not yet begun.
+    fn stop(&mut self);
+    /// Ends the request in progress, as if it had never started.
+    fn abort(&mut self);
+    /// Whether a request the user started is in progress.
+    fn busy_for_user(&self) -> bool;
+    /// The request's end, if it has ended ([`CoreError::ClockStalled`] after `limit` calls in
+    /// a row that saw the clock stand still).
+    fn settle(&mut self, now_ms: u64, limit: u32) -> Option<Result<Self::Outcome, CoreError>>;
+    /// The bytes to write now: the rest of the frame going out, else the next frame.
+    fn transmit(&mut self, now_ms: u64) -> Option<&[u8]>;
+    /// The UART took `n` of the bytes [`transmit`](Core::transmit) gave.
+    fn transmitted(&mut self, n: usize, now_ms: u64);
+    /// Where a shell reads the UART into.
+    fn rx_space(&mut self) -> &mut [u8];
+    /// `n` bytes were read into [`rx_space`](Core::rx_space).
+    fn rx_filled(&mut self, n: usize);
+    /// Feeds the bytes read until one completes an event.
+    fn drain(&mut self, now_ms: u64) -> Option<Self::Event>;
+    /// Judges time (reply timeouts, the failsafe); call once every byte the UART holds is in.
+    fn tick(&mut self, now_ms: u64) -> Option<Self::Event>;
+    /// How long until [`tick`](Core::tick) may have something to do, in ms.
+    fn wait_ms(&self, now_ms: u64) -> Option<u64>;
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for super::DriverCore {}
+    impl Sealed for super::v1::DriverCore {}
 }
 
 /// How the driver talks to the board, and its policies' limits.
@@ -275,6 +327,11 @@ pub enum CoreError {
     /// Whether the board still has a turn pending is not known (a new driver has not read the
     /// pending angle yet): read it first. The shells do it before the first turn.
     TurnStateUnknown,
+    /// v1.0.0: no reply to this readback in [`Config::read_tries`] requests.
+    NoReadback(crate::v1::Readback),
+    /// v1.0.0: the readback after a settings write does not carry what was written (the
+    /// board did not take it, or keeps other values).
+    ReadbackDiffers(crate::v1::Readback),
 }
 
 impl fmt::Display for CoreError {
@@ -295,6 +352,10 @@ impl fmt::Display for CoreError {
             CoreError::FramePending => f.write_str("a frame is still being sent"),
             CoreError::TurnStateUnknown => {
                 f.write_str("whether a turn is pending is not known: read the pending angle first")
+            }
+            CoreError::NoReadback(r) => write!(f, "no reply to the readback {r:?}"),
+            CoreError::ReadbackDiffers(r) => {
+                write!(f, "the readback {r:?} does not show what was written")
             }
         }
     }

@@ -110,7 +110,18 @@ impl StreamInfo {
         self.rate_millihertz / 1_000
     }
 
-    fn arrived(&mut self, at_ms: u64, missed: u32) {
+    /// Nothing received yet.
+    pub(crate) const fn new() -> Self {
+        StreamInfo {
+            frames: 0,
+            missed: 0,
+            rate_millihertz: 0,
+            window_start_ms: None,
+            window_frames: 0,
+        }
+    }
+
+    pub(crate) fn arrived(&mut self, at_ms: u64, missed: u32) {
         self.frames = self.frames.wrapping_add(1);
         self.missed = missed;
         let Some(start) = self.window_start_ms else {
@@ -216,7 +227,7 @@ impl RxBuffer {
     /// Bytes read from the UART at a time.
     pub(crate) const LEN: usize = 32;
 
-    const fn new() -> Self {
+    pub(crate) const fn new() -> Self {
         RxBuffer {
             bytes: [0; Self::LEN],
             start: 0,
@@ -224,8 +235,29 @@ impl RxBuffer {
         }
     }
 
-    const fn is_empty(&self) -> bool {
+    pub(crate) const fn is_empty(&self) -> bool {
         self.start >= self.end
+    }
+
+    /// Where the UART is read into.
+    pub(crate) fn space(&mut self) -> &mut [u8] {
+        &mut self.bytes
+    }
+
+    /// `n` bytes were read into [`space`](Self::space).
+    pub(crate) fn filled(&mut self, n: usize) {
+        self.start = 0;
+        self.end = n.min(Self::LEN);
+    }
+
+    /// The bytes read and not yet consumed.
+    pub(crate) fn pending(&self) -> &[u8] {
+        self.bytes.get(self.start..self.end).unwrap_or(&[])
+    }
+
+    /// Of the pending bytes, `rest` are left.
+    pub(crate) fn left(&mut self, rest: usize) {
+        self.start = self.end.saturating_sub(rest);
     }
 }
 
@@ -667,13 +699,12 @@ impl DriverCore {
     /// [`rx_filled`](Self::rx_filled) with the count read. The bytes are the core's: they
     /// survive a dropped future, an error and a rebuilt driver.
     pub fn rx_space(&mut self) -> &mut [u8] {
-        &mut self.rx.bytes
+        self.rx.space()
     }
 
     /// Records that `n` bytes were read into [`rx_space`](Self::rx_space).
     pub fn rx_filled(&mut self, n: usize) {
-        self.rx.start = 0;
-        self.rx.end = n.min(RxBuffer::LEN);
+        self.rx.filled(n);
     }
 
     /// Whether every byte read into [`rx_space`](Self::rx_space) has gone through the parser.
@@ -690,9 +721,9 @@ impl DriverCore {
         }
         let now = self.safety.advance(now_ms);
         self.last_byte_ms = Some(now);
-        let pending = self.rx.bytes.get(self.rx.start..self.rx.end).unwrap_or(&[]);
-        let (frame, rest) = self.parser.push_slice(pending);
-        self.rx.start = self.rx.end.saturating_sub(rest.len());
+        let (frame, rest) = self.parser.push_slice(self.rx.pending());
+        let rest = rest.len();
+        self.rx.left(rest);
         frame.map(|frame| self.frame(frame, now))
     }
 
@@ -1258,6 +1289,52 @@ impl DriverCore {
             info.arrived(now_ms, missed);
         }
         Event::Telemetry(frame)
+    }
+}
+
+impl super::Core for DriverCore {
+    type Event = Event;
+    type Request = Request;
+    type Outcome = Outcome;
+
+    fn set_config(&mut self, config: Config) {
+        DriverCore::set_config(self, config);
+    }
+    fn start(&mut self, request: Request) -> Result<(), CoreError> {
+        DriverCore::start(self, request)
+    }
+    fn stop(&mut self) {
+        DriverCore::stop(self);
+    }
+    fn abort(&mut self) {
+        DriverCore::abort(self);
+    }
+    fn busy_for_user(&self) -> bool {
+        DriverCore::busy_for_user(self)
+    }
+    fn settle(&mut self, now_ms: u64, limit: u32) -> Option<Result<Outcome, CoreError>> {
+        DriverCore::settle(self, now_ms, limit)
+    }
+    fn transmit(&mut self, now_ms: u64) -> Option<&[u8]> {
+        DriverCore::transmit(self, now_ms)
+    }
+    fn transmitted(&mut self, n: usize, now_ms: u64) {
+        DriverCore::transmitted(self, n, now_ms);
+    }
+    fn rx_space(&mut self) -> &mut [u8] {
+        DriverCore::rx_space(self)
+    }
+    fn rx_filled(&mut self, n: usize) {
+        DriverCore::rx_filled(self, n);
+    }
+    fn drain(&mut self, now_ms: u64) -> Option<Event> {
+        DriverCore::drain(self, now_ms)
+    }
+    fn tick(&mut self, now_ms: u64) -> Option<Event> {
+        DriverCore::tick(self, now_ms)
+    }
+    fn wait_ms(&self, now_ms: u64) -> Option<u64> {
+        DriverCore::wait_ms(self, now_ms)
     }
 }
 
