@@ -5,6 +5,7 @@
 use chassis_host_tests::channel::{Noise, transmit};
 use chassis_host_tests::{BoardStream, pieces};
 use chassis_protocol::parse::downlink::FORGET_AFTER;
+use chassis_protocol::{detect, v1};
 use chassis_protocol::{
     Action, Battery, Command, Downlink, DownlinkParser, Encoders, Imu, Kind, Motors, Register,
     Reply, Setting, SystemMode, Turn, UplinkParser, Velocity, Write,
@@ -250,4 +251,115 @@ proptest! {
             prop_assert!(out.contains(&f.frame), "lost {:?}", f.frame);
         }
     }
+}
+
+/// v1.0.0 commands with any field values.
+fn v1_command() -> impl Strategy<Value = v1::Command> {
+    use v1::{BodyVelocity, Command as C, Geometry, MotorVelocity, Pid, Readback, SystemSettings};
+    prop_oneof![
+        (any::<u8>(), any::<u8>(), any::<[i16; 3]>()).prop_map(|(ctl, kind, [x, y, z])| {
+            C::BodyVelocity(BodyVelocity {
+                ctl,
+                kind,
+                vx_mm_s: x,
+                vy_mm_s: y,
+                wz_mrad_s: z,
+            })
+        }),
+        (any::<u8>(), any::<u8>(), any::<[i16; 4]>())
+            .prop_map(|(ctl, kind, speeds)| C::MotorVelocity(MotorVelocity { ctl, kind, speeds })),
+        (any::<[u8; 2]>(), any::<[u16; 3]>()).prop_map(|([m, e], [a, b, c])| {
+            C::System(SystemSettings {
+                motor_directions: m,
+                encoder_directions: e,
+                pwm_max: a,
+                pwm_min: b,
+                encoder_ppr: c,
+            })
+        }),
+        any::<[u16; 4]>().prop_map(|[a, b, c, d]| C::Geometry(Geometry {
+            wheel_spacing_mm: a,
+            axle_spacing_mm: b,
+            gear_ratio: c,
+            wheel_diameter_mm: d,
+        })),
+        any::<[u16; 5]>().prop_map(|[a, b, c, d, e]| C::Pid(Pid {
+            position_kp: a,
+            position_ki: b,
+            position_kd: c,
+            velocity_kp: d,
+            velocity_ki: e,
+        })),
+        proptest::sample::select(Readback::ALL.to_vec()).prop_map(C::Readback),
+    ]
+}
+
+proptest! {
+    /// The v1.0.0 probe `chassis detect` sends, between any two frames of a 2020 command
+    /// stream (or alone): the 2020 board's parser finds in it nothing, and every 2020 frame
+    /// around it as sent.
+    #[test]
+    fn the_v1_probe_is_nothing_to_a_2020_board(
+        commands in proptest::collection::vec(command(), 0..8),
+        at in any::<proptest::sample::Index>(),
+    ) {
+        let at = at.index(commands.len() + 1);
+        let mut bytes = Vec::new();
+        for (i, c) in commands.iter().enumerate() {
+            if i == at {
+                bytes.extend(detect::PROBE_V1);
+            }
+            bytes.extend(c.clone().encode().as_slice());
+        }
+        if at == commands.len() {
+            bytes.extend(detect::PROBE_V1);
+        }
+        let mut parser = UplinkParser::new();
+        let got: Vec<Command> = parser.frames(&bytes).collect();
+        prop_assert_eq!(got, commands);
+    }
+
+    /// The 2020 probe, likewise, to a v1.0.0 board's parser.
+    #[test]
+    fn the_2020_probe_is_nothing_to_a_v1_board(
+        commands in proptest::collection::vec(v1_command(), 0..8),
+        at in any::<proptest::sample::Index>(),
+    ) {
+        use chassis_protocol::v1::Parser as _;
+        let at = at.index(commands.len() + 1);
+        let mut bytes = Vec::new();
+        for (i, c) in commands.iter().enumerate() {
+            if i == at {
+                bytes.extend(detect::PROBE_2020);
+            }
+            bytes.extend(c.encode());
+        }
+        if at == commands.len() {
+            bytes.extend(detect::PROBE_2020);
+        }
+        // Commands whose reserved bytes are not 00 are refused by decode, as by the board:
+        // the expected stream is what decode accepts.
+        let expected: Vec<v1::Command> = commands
+            .iter()
+            .filter(|c| v1::Command::decode(&c.encode()).is_ok())
+            .copied()
+            .collect();
+        let mut parser = v1::UplinkParser::new();
+        let got: Vec<v1::Command> = parser.frames(&bytes).collect();
+        prop_assert_eq!(got, expected);
+    }
+}
+
+/// Each probe alone, and each byte of it: nothing to the other generation's parser.
+#[test]
+fn each_probe_alone_is_nothing_to_the_other_generation() {
+    use chassis_protocol::v1::Parser as _;
+    let mut ff = UplinkParser::new();
+    assert_eq!(ff.frames(&detect::PROBE_V1).count(), 0);
+    ff.idle();
+    assert_eq!(ff.stats().frames, 0);
+    let mut v = v1::UplinkParser::new();
+    assert_eq!(v.frames(&detect::PROBE_2020).count(), 0);
+    assert_eq!(v.stats().frames, 0);
+    assert_eq!(v.stats().discarded, 10, "every byte thrown away");
 }

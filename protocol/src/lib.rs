@@ -37,6 +37,8 @@
 //! | [`units`] | conversions where the spec states the unit |
 //! | `driver` (feature) | the master-side driver: sans-IO core, blocking / `nb` / async shells |
 //! | `sim` (feature) | the board simulator |
+//! | [`v1`] | the v1.0.0 firmware's `7B … BCC 7D` frames and their parsers |
+//! | [`detect`] | which firmware a board runs, from what it sends (with `driver`: on a UART, with harmless probes) |
 //!
 //! There is no checksum in this protocol, and a gyro at rest writes false headers into every
 //! other IMU payload: how the board → master parser resynchronises, and the trade-off it makes
@@ -85,6 +87,7 @@ mod arbitrary;
 mod bytes;
 mod codes;
 pub mod command;
+pub mod detect;
 #[cfg(feature = "driver")]
 pub mod driver;
 mod error;
