@@ -1,23 +1,24 @@
 //! The simulated board behind in-memory adapters (feature `driver`): a UART ([`SimUart`]), a
 //! clock ([`SimClock`]) and, with `async`, a delay ([`SimDelay`]), all on one shared
-//! millisecond counter, so a test drives the board in simulated time.
+//! millisecond counter, so a test drives the board in simulated time. The UART takes any
+//! [`Simulated`] board, [`Board`] by default.
 
-use super::Board;
+use super::{Board, Simulated};
 
 /// The board behind an in-memory UART (features `sim` and `driver`): `embedded-io` `Read`,
 /// `Write` and `ReadReady`, for testing a master, or the [`crate::driver`], on the host. The
 /// board's time follows a shared [`Cell`](core::cell::Cell) of milliseconds, which
 /// [`SimClock`] advances.
 #[derive(Debug)]
-pub struct SimUart<'t> {
-    board: Board,
+pub struct SimUart<'t, B: Simulated = Board> {
+    board: B,
     time: &'t core::cell::Cell<u64>,
     burst_ms: u64,
 }
 
-impl<'t> SimUart<'t> {
+impl<'t, B: Simulated> SimUart<'t, B> {
     /// `board` behind a UART, on the clock `time`.
-    pub fn new(board: Board, time: &'t core::cell::Cell<u64>) -> Self {
+    pub fn new(board: B, time: &'t core::cell::Cell<u64>) -> Self {
         SimUart {
             board,
             time,
@@ -34,12 +35,12 @@ impl<'t> SimUart<'t> {
     }
 
     /// The board (to inspect it in a test).
-    pub fn board(&self) -> &Board {
+    pub fn board(&self) -> &B {
         &self.board
     }
 
     /// The board (to inject faults in a test).
-    pub fn board_mut(&mut self) -> &mut Board {
+    pub fn board_mut(&mut self) -> &mut B {
         &mut self.board
     }
 
@@ -50,25 +51,25 @@ impl<'t> SimUart<'t> {
     }
 }
 
-impl embedded_io::ErrorType for SimUart<'_> {
+impl<B: Simulated> embedded_io::ErrorType for SimUart<'_, B> {
     type Error = core::convert::Infallible;
 }
 
-impl embedded_io::Read for SimUart<'_> {
+impl<B: Simulated> embedded_io::Read for SimUart<'_, B> {
     fn read(&mut self, buf: &mut [u8]) -> Result<usize, Self::Error> {
         self.catch_up();
         Ok(self.board.transmit(buf))
     }
 }
 
-impl embedded_io::ReadReady for SimUart<'_> {
+impl<B: Simulated> embedded_io::ReadReady for SimUart<'_, B> {
     fn read_ready(&mut self) -> Result<bool, Self::Error> {
         self.catch_up();
         Ok(self.board.byte_arrived())
     }
 }
 
-impl embedded_io::Write for SimUart<'_> {
+impl<B: Simulated> embedded_io::Write for SimUart<'_, B> {
     fn write(&mut self, buf: &[u8]) -> Result<usize, Self::Error> {
         self.catch_up();
         self.board.receive(buf);
@@ -82,7 +83,7 @@ impl embedded_io::Write for SimUart<'_> {
 
 /// Waits (yields to the executor) until a byte is there, as a real UART's read does.
 #[cfg(feature = "async")]
-impl embedded_io_async::Read for SimUart<'_> {
+impl<B: Simulated> embedded_io_async::Read for SimUart<'_, B> {
     async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Self::Error> {
         loop {
             if embedded_io::ReadReady::read_ready(self)? || buf.is_empty() {
@@ -94,7 +95,7 @@ impl embedded_io_async::Read for SimUart<'_> {
 }
 
 #[cfg(feature = "async")]
-impl embedded_io_async::Write for SimUart<'_> {
+impl<B: Simulated> embedded_io_async::Write for SimUart<'_, B> {
     async fn write(&mut self, buf: &[u8]) -> Result<usize, Self::Error> {
         embedded_io::Write::write(self, buf)
     }

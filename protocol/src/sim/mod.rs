@@ -36,6 +36,8 @@
 //! | `adapters.rs` | (feature `driver`) in-memory UART, clock and delay on shared simulated time |
 //! | `serve.rs` | (feature `std`) the board in real time on an OS byte stream |
 //!
+//! [`Board`] implements [`Simulated`], which is all the adapters and `serve` need of a board.
+//!
 //! # Behaviour, and the decisions where the spec is silent
 //!
 //! * **Registers** have a live copy and a stored copy. [`Action::Store`](crate::Action::Store) copies live to stored,
@@ -75,11 +77,46 @@ mod telemetry;
 pub use adapters::SimDelay;
 #[cfg(feature = "driver")]
 pub use adapters::{SimClock, SimUart};
+use line::Line;
 pub use line::{Faults, OUT_CAPACITY};
 pub use motion::Motion;
 pub use registers::FACTORY;
 #[cfg(feature = "std")]
 pub use serve::serve;
+
+/// What the adapters ([`SimUart`], with feature `driver`) and [`serve`] (feature `std`) need
+/// of a simulated board ([`Board`] implements it: each method is the board's own, of the same
+/// name).
+pub trait Simulated {
+    /// Bytes from the master, taken at the board's current time.
+    fn receive(&mut self, bytes: &[u8]);
+    /// Moves the board's time forward to `now_ms` (ms since power-up); time never goes back.
+    fn advance(&mut self, now_ms: u64);
+    /// Copies bytes for the master that have crossed the wire by now into `buf`; how many.
+    fn transmit(&mut self, buf: &mut [u8]) -> usize;
+    /// Whether a byte for the master has crossed the wire by now.
+    fn byte_arrived(&self) -> bool;
+    /// The board's time in ms.
+    fn now_ms(&self) -> u64;
+}
+
+impl Simulated for Board {
+    fn receive(&mut self, bytes: &[u8]) {
+        Board::receive(self, bytes);
+    }
+    fn advance(&mut self, now_ms: u64) {
+        Board::advance(self, now_ms);
+    }
+    fn transmit(&mut self, buf: &mut [u8]) -> usize {
+        Board::transmit(self, buf)
+    }
+    fn byte_arrived(&self) -> bool {
+        Board::byte_arrived(self)
+    }
+    fn now_ms(&self) -> u64 {
+        Board::now_ms(self)
+    }
+}
 
 /// How the simulated board behaves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -107,7 +144,7 @@ impl Default for SimConfig {
 #[derive(Clone, Debug)]
 pub struct Board {
     config: SimConfig,
-    faults: Faults,
+    line: Line,
     uplink: UplinkParser,
     now_ms: u64,
     live: Snapshot,
@@ -124,18 +161,7 @@ pub struct Board {
     quiet_until_ms: u64,
     calibrating_until_ms: Option<u64>,
     replies: Deque<(u64, Reply), 8>,
-    out: Deque<u8, OUT_CAPACITY>,
-    /// The frames in `out` as (when their first byte starts on the wire in ns, length): bytes
-    /// leave at the line's pace (10 bits a byte at 115 200 bps), a frame from the moment it is
-    /// sent or the moment the one before it has left.
-    on_wire: Deque<(u64, u16), 160>,
-    /// Bytes of the front frame of `on_wire` already handed over.
-    front_taken: u16,
-    /// When the last byte queued will have left, in ns.
-    line_free_ns: u64,
-    rng: u64,
     commands: u32,
-    dropped_frames: u32,
 }
 
 #[cfg(feature = "defmt")]
@@ -147,7 +173,7 @@ impl defmt::Format for Board {
             self.now_ms,
             self.motion,
             self.pending_deci_degrees,
-            self.out.len()
+            self.line.queued()
         );
     }
 }
@@ -158,7 +184,7 @@ impl Board {
     pub fn new(config: SimConfig) -> Self {
         Board {
             config,
-            faults: Faults::default(),
+            line: Line::new(config.seed),
             uplink: UplinkParser::new(),
             now_ms: 0,
             live: FACTORY,
@@ -175,19 +201,13 @@ impl Board {
             quiet_until_ms: 0,
             calibrating_until_ms: None,
             replies: Deque::new(),
-            out: Deque::new(),
-            on_wire: Deque::new(),
-            front_taken: 0,
-            line_free_ns: 0,
-            rng: config.seed | 1,
             commands: 0,
-            dropped_frames: 0,
         }
     }
 
     /// Sets the faults to inject from now on.
     pub fn set_faults(&mut self, faults: Faults) {
-        self.faults = faults;
+        self.line.faults = faults;
     }
 
     /// Bytes from the master, taken at the board's current time.
@@ -269,7 +289,7 @@ impl Board {
     /// Downlink frames dropped because the output buffer was full.
     #[must_use]
     pub const fn dropped_frames(&self) -> u32 {
-        self.dropped_frames
+        self.line.dropped_frames
     }
 
     fn execute(&mut self, command: Command) {
@@ -313,7 +333,7 @@ impl Board {
                 break;
             }
             let _ = self.replies.pop_front();
-            if !self.faults.replies_stopped {
+            if !self.line.faults.replies_stopped {
                 self.send(&reply.encode());
             }
         }

@@ -1,7 +1,8 @@
 //! The simulated board in real time on an OS byte stream (feature `std`): a pseudo-terminal,
 //! a TCP socket, a serial port. What a host program, the CLI and the emulator tests talk to.
+//! Any [`Simulated`] board.
 
-use super::Board;
+use super::Simulated;
 use std::io::{self, Read, Write};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -12,7 +13,11 @@ use std::time::{Duration, Instant};
 /// writes what the board has sent since. A read that times out or would block is no error; an
 /// end of stream ends the run. Bytes the other end does not take (a write that times out or
 /// would block) are dropped, as on a line nobody listens to: the board serves until stopped.
-pub fn serve<T: Read + Write>(mut board: Board, mut io: T, stop: &AtomicBool) -> io::Result<Board> {
+pub fn serve<B: Simulated, T: Read + Write>(
+    mut board: B,
+    mut io: T,
+    stop: &AtomicBool,
+) -> io::Result<B> {
     let start = Instant::now();
     let offset = board.now_ms();
     let mut buf = [0u8; 256];
@@ -76,7 +81,7 @@ fn send<T: Write>(io: &mut T, mut bytes: &[u8]) -> io::Result<()> {
 mod tests {
     use super::*;
     use crate::command::{Register, Setting};
-    use crate::sim::SimConfig;
+    use crate::sim::{Board, SimConfig};
 
     /// The master sends one read, then never reads: every write times out (a pseudo-terminal's
     /// buffer full). After 300 turns of the loop it sets `stop`.
