@@ -1,7 +1,7 @@
 //! The simulated board behind in-memory adapters (feature `driver`): a UART ([`SimUart`]), a
 //! clock ([`SimClock`]) and, with `async`, a delay ([`SimDelay`]), all on one shared
-//! millisecond counter, so a test drives the board in simulated time. The UART takes any
-//! [`Simulated`] board, [`Board`] by default.
+//! millisecond counter, so a test drives the board in simulated time. The UART takes either
+//! board ([`Simulated`]): the 2020 [`Board`] by default, or a [`v1::Board`](super::v1::Board).
 
 use super::{Board, Simulated};
 

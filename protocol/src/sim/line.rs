@@ -1,6 +1,6 @@
 //! The line from the board to the master: bytes leave at 115 200 bps (10 bits a byte), a
-//! bounded buffer holds them, and injected faults drop, change or add bytes on the way. A board
-//! sends through one.
+//! bounded buffer holds them, and injected faults drop, change or add bytes on the way. Both
+//! boards (2020 and [v1.0.0](super::v1)) send through one.
 
 use heapless::Deque;
 

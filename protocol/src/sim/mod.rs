@@ -35,8 +35,9 @@
 //! | `line.rs` | the line to the master: pacing at 115 200 bps, its buffer, [`Faults`] |
 //! | `adapters.rs` | (feature `driver`) in-memory UART, clock and delay on shared simulated time |
 //! | `serve.rs` | (feature `std`) the board in real time on an OS byte stream |
+//! | `v1.rs` | [`v1::Board`]: the v1.0.0 firmware's board (`7B … BCC 7D`), on the same line |
 //!
-//! [`Board`] implements [`Simulated`], which is all the adapters and `serve` need of a board.
+//! Both boards implement [`Simulated`], which is all the adapters and `serve` need of them.
 //!
 //! # Behaviour, and the decisions where the spec is silent
 //!
@@ -72,6 +73,7 @@ mod registers;
 #[cfg(feature = "std")]
 mod serve;
 mod telemetry;
+pub mod v1;
 
 #[cfg(feature = "async")]
 pub use adapters::SimDelay;
@@ -85,8 +87,8 @@ pub use registers::FACTORY;
 pub use serve::serve;
 
 /// What the adapters ([`SimUart`], with feature `driver`) and [`serve`] (feature `std`) need
-/// of a simulated board ([`Board`] implements it: each method is the board's own, of the same
-/// name).
+/// of a simulated board: both generations, [`Board`] (2020) and [`v1::Board`] (v1.0.0),
+/// implement it (each method is the board's own, of the same name).
 pub trait Simulated {
     /// Bytes from the master, taken at the board's current time.
     fn receive(&mut self, bytes: &[u8]);

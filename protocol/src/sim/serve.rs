@@ -1,6 +1,7 @@
 //! The simulated board in real time on an OS byte stream (feature `std`): a pseudo-terminal,
 //! a TCP socket, a serial port. What a host program, the CLI and the emulator tests talk to.
-//! Any [`Simulated`] board.
+//! Either board ([`Simulated`]): the 2020 [`Board`](super::Board) or a
+//! [`v1::Board`](super::v1::Board).
 
 use super::Simulated;
 use std::io::{self, Read, Write};
