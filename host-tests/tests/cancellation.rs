@@ -1,4 +1,5 @@
-//! Every public async call of the driver cut at every await point, and every blocking call cut
+//! Every public async call of the driver (for both firmware generations) cut at every await
+//! point, and every blocking call cut
 //! by a transport error after every byte count, checked on the simulated board's side: every
 //! byte it received belongs to a whole frame the user asked for, in order; no turn was sent
 //! twice or lost; a write either reached the board whole or not at all; and the driver's next
@@ -11,7 +12,7 @@
 use chassis_protocol::driver::asynch::Driver as AsyncDriver;
 use chassis_protocol::driver::blocking::Driver;
 use chassis_protocol::driver::{Config, Error, TurnState, reg};
-use chassis_protocol::sim::{Board, FACTORY, SimClock, SimConfig, SimDelay, SimUart};
+use chassis_protocol::sim::{Board, FACTORY, SimClock, SimConfig, SimDelay, SimUart, Simulated};
 use chassis_protocol::{Action, Motors, Velocity, Write};
 use core::cell::Cell;
 use core::future::Future;
@@ -124,8 +125,8 @@ fn frames(wire: &[u8]) -> Result<Vec<(usize, Frame)>, String> {
 /// (a full TX buffer, a DMA chunk), recording what the board received; the async write waits
 /// once before it takes anything (the await point a `select` can cut), and its blocking write
 /// fails once `fail_at` bytes have been taken (a transport error mid-frame).
-struct Choppy<'t> {
-    uart: SimUart<'t>,
+struct Choppy<'t, B: Simulated = Board> {
+    uart: SimUart<'t, B>,
     wire: Vec<u8>,
     chunk: usize,
     fail_at: Option<usize>,
@@ -133,8 +134,14 @@ struct Choppy<'t> {
 
 impl<'t> Choppy<'t> {
     fn new(time: &'t Cell<u64>, chunk: usize) -> Self {
+        Choppy::with(Board::new(SimConfig::default()), time, chunk)
+    }
+}
+
+impl<'t, B: Simulated> Choppy<'t, B> {
+    fn with(board: B, time: &'t Cell<u64>, chunk: usize) -> Self {
         Choppy {
-            uart: SimUart::new(Board::new(SimConfig::default()), time),
+            uart: SimUart::new(board, time),
             wire: Vec::new(),
             chunk,
             fail_at: None,
@@ -169,23 +176,23 @@ impl embedded_io::Error for Cut {
     }
 }
 
-impl embedded_io::ErrorType for Choppy<'_> {
+impl<B: Simulated> embedded_io::ErrorType for Choppy<'_, B> {
     type Error = Cut;
 }
 
-impl embedded_io::Read for Choppy<'_> {
+impl<B: Simulated> embedded_io::Read for Choppy<'_, B> {
     fn read(&mut self, buf: &mut [u8]) -> Result<usize, Cut> {
         Ok(embedded_io::Read::read(&mut self.uart, buf).unwrap())
     }
 }
 
-impl ReadReady for Choppy<'_> {
+impl<B: Simulated> ReadReady for Choppy<'_, B> {
     fn read_ready(&mut self) -> Result<bool, Cut> {
         Ok(self.uart.read_ready().unwrap())
     }
 }
 
-impl embedded_io::Write for Choppy<'_> {
+impl<B: Simulated> embedded_io::Write for Choppy<'_, B> {
     fn write(&mut self, buf: &[u8]) -> Result<usize, Cut> {
         if self.fail_at.is_some_and(|at| self.wire.len() >= at) && !buf.is_empty() {
             self.fail_at = None;
@@ -199,7 +206,7 @@ impl embedded_io::Write for Choppy<'_> {
     }
 }
 
-impl embedded_io_async::Read for Choppy<'_> {
+impl<B: Simulated> embedded_io_async::Read for Choppy<'_, B> {
     async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Cut> {
         Ok(embedded_io_async::Read::read(&mut self.uart, buf)
             .await
@@ -207,7 +214,7 @@ impl embedded_io_async::Read for Choppy<'_> {
     }
 }
 
-impl embedded_io_async::Write for Choppy<'_> {
+impl<B: Simulated> embedded_io_async::Write for Choppy<'_, B> {
     async fn write(&mut self, buf: &[u8]) -> Result<usize, Cut> {
         embassy_futures::yield_now().await;
         Ok(self.take(buf))
@@ -563,4 +570,249 @@ fn a_half_sent_turn_then_stop_never_spins_the_board() {
         board.motion(),
         chassis_protocol::sim::Motion::Velocity { x: 0, y: 0, z: 0 }
     );
+}
+
+// ----- the v1.0.0 board: the same shells over `driver::v1::DriverCore` -----
+
+mod v1_board {
+    use super::*;
+    use chassis_protocol::driver::v1::{DriverCore, Settings};
+    use chassis_protocol::sim::v1::{Board as V1Board, SimConfig as V1Config};
+    use chassis_protocol::v1::{BodyVelocity, Geometry, MotorVelocity, Readback};
+
+    // The frames a v1.0.0 board may receive, by hand from PROTOCOL-V1.md (BCC = XOR of the
+    // bytes before it, worked out by hand).
+
+    /// `0x25`: vx 0, vy 300 mm/s (0x012C), wz 0, ctl 2, type 4.
+    const VELOCITY: [u8; 14] = [
+        0x7B, 0x25, 0x02, 0x04, 0x00, 0x00, 0x01, 0x2C, 0x00, 0x00, 0x00, 0x00, 0x75, 0x7D,
+    ];
+    /// `0x25` forced stop: ctl 0, all zeros.
+    const FORCED_STOP: [u8; 14] = [
+        0x7B, 0x25, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x5E, 0x7D,
+    ];
+    /// `0x26`: motors 100, −100, 100, −100 (FF9C), ctl 2, type 4.
+    const MOTORS: [u8; 14] = [
+        0x7B, 0x26, 0x02, 0x04, 0x00, 0x64, 0xFF, 0x9C, 0x00, 0x64, 0xFF, 0x9C, 0x5B, 0x7D,
+    ];
+    /// `0x24`: wheel spacing 120 (0x78), axle spacing 110 (0x6E), gear 55 (0x37), wheel 60
+    /// (0x3C).
+    const GEOMETRY: [u8; 14] = [
+        0x7B, 0x24, 0x00, 0x78, 0x00, 0x6E, 0x00, 0x37, 0x00, 0x3C, 0x00, 0x00, 0x42, 0x7D,
+    ];
+    /// Readback requests and their BCC (`7B ^ code`).
+    const READBACKS: [(u8, u8); 5] = [
+        (0x33, 0x48),
+        (0x34, 0x4F),
+        (0x35, 0x4E),
+        (0x36, 0x4D),
+        (0x50, 0x2B),
+    ];
+
+    #[derive(Clone, Debug, PartialEq, Eq)]
+    enum Frame {
+        Velocity,
+        Stop,
+        Motors,
+        Geometry,
+        Readback(u8),
+    }
+
+    /// Cuts the board's byte stream into 14-byte frames; each must be one of [`Frame`]'s.
+    fn frames(wire: &[u8]) -> Result<Vec<(usize, Frame)>, String> {
+        let mut out = Vec::new();
+        for (i, frame) in wire.chunks(14).enumerate() {
+            let at = i * 14;
+            let known = if frame == VELOCITY {
+                Frame::Velocity
+            } else if frame == FORCED_STOP {
+                Frame::Stop
+            } else if frame == MOTORS {
+                Frame::Motors
+            } else if frame == GEOMETRY {
+                Frame::Geometry
+            } else if let [0x7B, code, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, bcc, 0x7D] = frame {
+                if !READBACKS.contains(&(*code, *bcc)) {
+                    return Err(format!("no readback at byte {at}: {frame:02X?}"));
+                }
+                Frame::Readback(*code)
+            } else {
+                return Err(format!(
+                    "a frame nobody asked for (or cut) at byte {at}: {frame:02X?}"
+                ));
+            };
+            out.push((at, known));
+        }
+        Ok(out)
+    }
+
+    #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+    enum Call {
+        SetVelocity,
+        SetMotors,
+        Readback,
+        Geometry,
+        WriteSettings,
+        Stop,
+        Poll,
+    }
+
+    const CALLS: [Call; 7] = [
+        Call::SetVelocity,
+        Call::SetMotors,
+        Call::Readback,
+        Call::Geometry,
+        Call::WriteSettings,
+        Call::Stop,
+        Call::Poll,
+    ];
+
+    const WIDER: Geometry = Geometry {
+        wheel_spacing_mm: 120,
+        axle_spacing_mm: 110,
+        gear_ratio: 55,
+        wheel_diameter_mm: 60,
+    };
+
+    type Async<'t> = AsyncDriver<Choppy<'t, V1Board>, SimClock<'t>, SimDelay<'t>, DriverCore>;
+    type Blocking<'t> = Driver<Choppy<'t, V1Board>, SimClock<'t>, DriverCore>;
+
+    fn call_async<'a>(d: &'a mut Async<'_>, call: Call) -> Boxed<'a> {
+        match call {
+            Call::SetVelocity => Box::pin(d.set_velocity(BodyVelocity::new(0, 300, 0))),
+            Call::SetMotors => Box::pin(d.set_motors(MotorVelocity::new([100, -100, 100, -100]))),
+            Call::Readback => {
+                Box::pin(async { d.readback(Readback::MotorSpeeds).await.map(|_| ()) })
+            }
+            Call::Geometry => Box::pin(async { d.readback(Readback::Geometry).await.map(|_| ()) }),
+            Call::WriteSettings => Box::pin(d.write_settings(Settings::Geometry(WIDER))),
+            Call::Stop => Box::pin(d.stop()),
+            Call::Poll => Box::pin(async { d.poll().await.map(|_| ()) }),
+        }
+    }
+
+    fn call_blocking(d: &mut Blocking<'_>, call: Call) -> Result<(), Error<Cut>> {
+        match call {
+            Call::SetVelocity => d.set_velocity(BodyVelocity::new(0, 300, 0)),
+            Call::SetMotors => d.set_motors(MotorVelocity::new([100, -100, 100, -100])),
+            Call::Readback => d.readback(Readback::MotorSpeeds).map(|_| ()),
+            Call::Geometry => d.geometry().map(|_| ()),
+            Call::WriteSettings => d.write_settings(Settings::Geometry(WIDER)),
+            Call::Stop => d.stop(),
+            Call::Poll => d.poll().map(|_| ()),
+        }
+    }
+
+    /// Judges what the board received: only whole frames, each one the board executed; the
+    /// settings write reached it whole or not at all (the readback after says which); a
+    /// forced stop after the call and only readbacks after it; the chassis still at the end.
+    fn judge(what: &str, uart: &Choppy<'_, V1Board>, before: usize, wheel_spacing_read: u16) {
+        let frames = frames(&uart.wire).unwrap_or_else(|e| panic!("{what}: {e}"));
+        let board = uart.uart.board();
+        assert_eq!(
+            board.total_commands() as usize,
+            frames.len(),
+            "{what}: the board took another count of frames than whole frames sent"
+        );
+        let wrote = frames.iter().any(|(_, f)| *f == Frame::Geometry);
+        assert_eq!(
+            wheel_spacing_read,
+            if wrote { 120 } else { 110 },
+            "{what}: the geometry read back"
+        );
+        let last_stop = frames
+            .iter()
+            .rposition(|(_, f)| *f == Frame::Stop)
+            .unwrap_or_else(|| panic!("{what}: no forced stop after the call"));
+        for (at, f) in &frames[last_stop + 1..] {
+            assert!(
+                matches!(f, Frame::Readback(_)),
+                "{what}: {f:?} at byte {at} after the stop"
+            );
+        }
+        assert!(
+            before.is_multiple_of(14),
+            "{what}: the call's bytes do not start on a frame boundary"
+        );
+        assert_eq!(board.velocity(), BodyVelocity::FORCED_STOP, "{what}");
+    }
+
+    #[test]
+    fn every_v1_async_call_cut_at_every_await_point_leaves_only_whole_frames_and_a_working_driver()
+    {
+        let mut cuts = 0;
+        for chunk in [1, 5] {
+            for call in CALLS {
+                for polls in 0.. {
+                    let time = Cell::new(0);
+                    let board = V1Board::new(V1Config::default());
+                    let uart = Choppy::with(board, &time, chunk);
+                    let mut d =
+                        Async::new_v1(uart, SimClock(&time), SimDelay(&time), Config::DEFAULT);
+                    let before = d.uart().wire.len();
+                    let mut cx = Context::from_waker(Waker::noop());
+                    let finished = {
+                        let mut future = call_async(&mut d, call);
+                        let mut finished = false;
+                        for _ in 0..polls {
+                            if future.as_mut().poll(&mut cx).is_ready() {
+                                finished = true;
+                                break;
+                            }
+                        }
+                        finished
+                    };
+                    let what = format!("v1 {call:?} after {polls} polls, {chunk}-byte writes");
+                    embassy_futures::block_on(d.stop())
+                        .unwrap_or_else(|e| panic!("{what}: stop: {e:?}"));
+                    let geometry = embassy_futures::block_on(d.readback(Readback::Geometry))
+                        .unwrap_or_else(|e| panic!("{what}: read after: {e:?}"))
+                        .geometry()
+                        .unwrap();
+                    judge(&what, d.uart(), before, geometry.wheel_spacing_mm);
+                    cuts += 1;
+                    if finished {
+                        break;
+                    }
+                    assert!(polls < 20_000, "{what}: never finished");
+                }
+            }
+        }
+        assert!(cuts > 100, "{cuts} cut points");
+    }
+
+    #[test]
+    fn every_v1_blocking_call_cut_by_a_transport_error_after_every_byte_leaves_only_whole_frames() {
+        let mut cuts = 0;
+        for call in CALLS {
+            for at in 0.. {
+                let time = Cell::new(0);
+                let uart = Choppy::with(V1Board::new(V1Config::default()), &time, 3);
+                let mut d = Blocking::new_v1(uart, SimClock(&time), Config::DEFAULT);
+                let before = d.uart().wire.len();
+                d.uart_mut().fail_at = Some(before + at);
+                let result = call_blocking(&mut d, call);
+                let cut = d.uart().fail_at.is_none();
+                d.uart_mut().fail_at = None;
+                if cut {
+                    assert_eq!(
+                        result,
+                        Err(Error::Transport(Cut)),
+                        "v1 {call:?} cut at {at}"
+                    );
+                }
+                let what = format!("v1 {call:?} cut at byte {at}");
+                d.stop().unwrap_or_else(|e| panic!("{what}: stop: {e:?}"));
+                let geometry = d
+                    .geometry()
+                    .unwrap_or_else(|e| panic!("{what}: read after: {e:?}"));
+                judge(&what, d.uart(), before, geometry.wheel_spacing_mm);
+                cuts += 1;
+                if !cut {
+                    break;
+                }
+            }
+        }
+        assert!(cuts > 50, "{cuts} cut points");
+    }
 }
