@@ -201,6 +201,9 @@ enum Cmd {
         /// Seed of the board's noise and faults.
         #[arg(long, default_value = "1")]
         seed: u64,
+        /// The board's firmware: 2020 (FF FE frames) or v1.0.0 (7B … 7D frames; also v1).
+        #[arg(long, value_name = "VERSION", default_value = "2020", value_parser = sim::firmware)]
+        firmware: sim::Firmware,
     },
 }
 
@@ -433,11 +436,12 @@ fn run(cli: Cli) -> Result<(), String> {
             tcp,
             faults,
             seed,
+            firmware,
         } => {
             let faults = sim::faults(faults)?;
             match (pty, tcp) {
-                (true, _) => sim::pty(seed, faults),
-                (false, Some(addr)) => sim::tcp(&addr, seed, faults),
+                (true, _) => sim::pty(firmware, seed, faults),
+                (false, Some(addr)) => sim::tcp(&addr, firmware, seed, faults),
                 (false, None) => Err("sim: give --pty or --tcp ADDR".into()),
             }
         }

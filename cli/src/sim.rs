@@ -1,9 +1,28 @@
 //! `chassis sim`: the simulated board in real time on a pseudo-terminal or a TCP port, so that
 //! every command can be tried without hardware (and the QEMU firmware has a chassis to drive).
+//! Either firmware generation: the 2020 board (`FF FE` frames) or the v1.0.0 one (`7B … 7D`).
 
-use chassis_protocol::sim::{Board, Faults, SimConfig, serve};
+use chassis_protocol::sim::{self, Board, Faults, SimConfig, Simulated, serve};
 use std::net::TcpListener;
 use std::sync::atomic::AtomicBool;
+
+/// The firmware the simulated board runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Firmware {
+    /// The 2020 firmware (`FF FE` frames, PROTOCOL.md).
+    V2020,
+    /// v1.0.0 (`7B … BCC 7D` frames, PROTOCOL-V1.md).
+    V1,
+}
+
+/// `--firmware`: exactly `2020`, `v1.0.0` or `v1`.
+pub fn firmware(name: &str) -> Result<Firmware, String> {
+    match name {
+        "2020" => Ok(Firmware::V2020),
+        "v1.0.0" | "v1" => Ok(Firmware::V1),
+        _ => Err("the simulated board runs firmware 2020 or v1.0.0 (or v1)".into()),
+    }
+}
 
 /// Line faults from a rate of errors per byte: a third each dropped, changed and added.
 pub fn faults(rate: f64) -> Result<Faults, String> {
@@ -30,10 +49,29 @@ fn board(seed: u64, faults: Faults) -> Board {
     board
 }
 
+fn board_v1(seed: u64, faults: Faults) -> sim::v1::Board {
+    let mut board = sim::v1::Board::new(sim::v1::SimConfig {
+        seed,
+        ..sim::v1::SimConfig::default()
+    });
+    board.set_faults(faults);
+    board
+}
+
 /// Serves a simulated board on a new pseudo-terminal until the process is stopped; prints the
 /// path to open.
 #[cfg(unix)]
-pub fn pty(seed: u64, faults: Faults) -> Result<(), String> {
+pub fn pty(firmware: Firmware, seed: u64, faults: Faults) -> Result<(), String> {
+    match firmware {
+        Firmware::V2020 => on_pty(board(seed, faults), "try `chassis --port {path} settings`"),
+        Firmware::V1 => on_pty(board_v1(seed, faults), "firmware v1.0.0, 7B … 7D frames"),
+    }
+}
+
+/// Serves `board` on a new pseudo-terminal; `hint` (with `{path}` in it) follows the path on
+/// stderr.
+#[cfg(unix)]
+fn on_pty<B: Simulated>(board: B, hint: &str) -> Result<(), String> {
     use serialport::SerialPort as _;
     let (mut board_end, master_end) =
         serialport::TTYPort::pair().map_err(|e| format!("cannot make a pseudo-terminal: {e}"))?;
@@ -42,14 +80,13 @@ pub fn pty(seed: u64, faults: Faults) -> Result<(), String> {
         .map_err(|e| format!("pseudo-terminal: {e}"))?;
     let path = master_end.name().ok_or("the pseudo-terminal has no path")?;
     say!("{path}");
-    tell!(
-        "chassis sim: a simulated board on {path} (115200 8N1); try `chassis --port {path} settings`. Ctrl-C stops it."
-    );
+    let hint = hint.replace("{path}", &path);
+    tell!("chassis sim: a simulated board on {path} (115200 8N1); {hint}. Ctrl-C stops it.");
     // The other end stays open here, so the board's end never reads an end of file while no
     // client has the path open.
     let keep = master_end;
     let stop = AtomicBool::new(false);
-    let result = serve(board(seed, faults), board_end, &stop);
+    let result = serve(board, board_end, &stop);
     drop(keep);
     result
         .map(|_| ())
@@ -58,13 +95,30 @@ pub fn pty(seed: u64, faults: Faults) -> Result<(), String> {
 
 /// No pseudo-terminals off Unix.
 #[cfg(not(unix))]
-pub fn pty(_seed: u64, _faults: Faults) -> Result<(), String> {
+pub fn pty(_firmware: Firmware, _seed: u64, _faults: Faults) -> Result<(), String> {
     Err("--pty needs a Unix pseudo-terminal; use --tcp".into())
 }
 
 /// Serves a simulated board to each client of a TCP listener on `addr`, one at a time, a fresh
 /// board each.
-pub fn tcp(addr: &str, seed: u64, faults: Faults) -> Result<(), String> {
+pub fn tcp(addr: &str, firmware: Firmware, seed: u64, faults: Faults) -> Result<(), String> {
+    match firmware {
+        Firmware::V2020 => on_tcp(addr, || board(seed, faults), Board::commands),
+        Firmware::V1 => on_tcp(
+            addr,
+            || board_v1(seed, faults),
+            sim::v1::Board::total_commands,
+        ),
+    }
+}
+
+/// Serves a board `fresh` makes to each client of a TCP listener on `addr`; `commands` says
+/// how many it took.
+fn on_tcp<B: Simulated>(
+    addr: &str,
+    fresh: impl Fn() -> B,
+    commands: impl Fn(&B) -> u32,
+) -> Result<(), String> {
     let listener = TcpListener::bind(addr).map_err(|e| format!("cannot listen on {addr}: {e}"))?;
     let local = listener.local_addr().map_err(|e| format!("{addr}: {e}"))?;
     say!("{local}");
@@ -80,11 +134,11 @@ pub fn tcp(addr: &str, seed: u64, faults: Faults) -> Result<(), String> {
             .map_err(|e| format!("{peer}: {e}"))?;
         tell!("chassis sim: {peer} connected");
         let stop = AtomicBool::new(false);
-        match serve(board(seed, faults), stream, &stop) {
+        match serve(fresh(), stream, &stop) {
             Ok(board) => tell!(
                 "chassis sim: {peer} left after {:.1} s ({} commands)",
                 board.now_ms() as f64 / 1000.0,
-                board.commands()
+                commands(&board)
             ),
             Err(e) => tell!("chassis sim: {peer}: {e}"),
         }
