@@ -32,6 +32,7 @@ macro_rules! tell_partial {
 }
 
 mod check;
+mod connect;
 mod decode;
 mod device;
 mod encode;
@@ -42,8 +43,10 @@ mod port;
 mod record;
 mod signals;
 mod sim;
+mod v1cmd;
 mod value;
 
+use chassis_protocol::detect::Firmware;
 use clap::{Parser, Subcommand};
 use names::RegisterName;
 use std::io::{Read, Write};
@@ -60,6 +63,11 @@ struct Cli {
     /// with `chassis decode FILE --input saleae-csv --quiet-ms 40 --master-analyzer master`).
     #[arg(long, global = true, value_name = "FILE")]
     record: Option<String>,
+    /// The board's firmware: 2020 (FF FE frames) or v1.0.0 (7B … 7D frames; also v1). Without
+    /// it, each command finds out from what the board sends (`chassis detect` says which);
+    /// `chassis sim` serves a 2020 board.
+    #[arg(long, global = true, value_name = "VERSION", value_parser = connect::firmware_arg)]
+    firmware: Option<chassis_protocol::detect::Firmware>,
     #[command(subcommand)]
     command: Cmd,
 }
@@ -103,15 +111,22 @@ enum Cmd {
         #[command(subcommand)]
         frame: encode::Frame,
     },
-    /// Read a register (each read verified: two replies must agree).
+    /// Say which firmware the board runs (2020 or v1.0.0), from what it sends: listens first,
+    /// then, on a quiet line, sends a register read of each firmware (nothing else). Exit status
+    /// 0, 3 when nothing came, 4 when bytes of neither firmware came.
+    Detect,
+    /// Read a register (2020: each read verified, two replies must agree; v1.0.0: a readback,
+    /// system / geometry / body-velocity / motor-speeds / pid, or one of their fields).
     Get {
-        /// The register.
-        register: RegisterName,
+        /// The register (2020: max-speed, kp, ki, gyro-gain, system-mode, gyro-calibration,
+        /// motor-voltage, battery-range, pending-angle).
+        register: String,
     },
-    /// Write a register and read it back (battery-range: FULL CUTOFF, 0.01 V each).
+    /// Write a register and read it back (battery-range: FULL CUTOFF, 0.01 V each; v1.0.0: a
+    /// settings field, e.g. wheel-diameter, written with the rest of its frame as read).
     Set {
         /// The register.
-        register: RegisterName,
+        register: String,
         /// The value (decimal or 0x hex).
         #[arg(allow_hyphen_values = true)]
         value: String,
@@ -138,10 +153,20 @@ enum Cmd {
     CalibrateGyro,
     /// Stop the chassis, and cancel a turn the board still has pending.
     Stop,
-    /// Drive at a velocity for a while, then stop (Ctrl-C stops at once).
+    /// Drive at a velocity for a while, then stop (Ctrl-C stops at once). 2020: --x --y --z
+    /// (the board's raw units); v1.0.0: --vx --vy (m/s) --wz (rad/s).
     Drive {
         #[command(flatten)]
         axes: encode::Axes,
+        /// v1.0.0: sideways velocity, m/s.
+        #[arg(long, value_name = "M/S", allow_hyphen_values = true)]
+        vx: Option<f64>,
+        /// v1.0.0: forward velocity, m/s.
+        #[arg(long, value_name = "M/S", allow_hyphen_values = true)]
+        vy: Option<f64>,
+        /// v1.0.0: rotation, rad/s (counter-clockwise positive).
+        #[arg(long, value_name = "RAD/S", allow_hyphen_values = true)]
+        wz: Option<f64>,
         /// How long, in seconds.
         #[arg(long = "for", value_name = "SECONDS")]
         seconds: f64,
@@ -201,9 +226,6 @@ enum Cmd {
         /// Seed of the board's noise and faults.
         #[arg(long, default_value = "1")]
         seed: u64,
-        /// The board's firmware: 2020 (FF FE frames) or v1.0.0 (7B … 7D frames; also v1).
-        #[arg(long, value_name = "VERSION", default_value = "2020", value_parser = sim::firmware)]
-        firmware: sim::Firmware,
     },
 }
 
@@ -242,6 +264,17 @@ fn main() -> ExitCode {
         } => port(cli.port.as_deref())
             .map_err(|e| (e, 1))
             .and_then(|path| {
+                if connect::generation(path, cli.firmware).map_err(|e| (e, 1))?
+                    == Firmware::V1_0_0
+                {
+                    return Err((
+                        not_on_v1(
+                            "check",
+                            "the bring-up checks are the 2020 firmware's (try `chassis detect`, `chassis get system`, `chassis drive --vy 0.1 --for 1`)",
+                        ),
+                        1,
+                    ));
+                }
                 check::check(
                     path,
                     no_motion,
@@ -249,6 +282,9 @@ fn main() -> ExitCode {
                     drive_type.map(DriveTypeName::drive_type),
                 )
             }),
+        Cmd::Detect => port(cli.port.as_deref())
+            .map_err(|e| (e, 1))
+            .and_then(connect::detect_command),
         // A signal the command caught (and stopped the chassis for): 128 + its number, as a
         // shell reports a process the signal ended.
         _ => run(cli).map_err(|e| (e, signals::caught().map_or(1, signals::exit_status))),
@@ -347,6 +383,30 @@ fn read_input(file: Option<&str>) -> Result<Vec<u8>, String> {
     }
 }
 
+/// A 2020 register by its name on the command line.
+fn register_2020(name: &str) -> Result<RegisterName, String> {
+    <RegisterName as clap::ValueEnum>::from_str(name, false).map_err(|_| {
+        let names: Vec<String> = <RegisterName as clap::ValueEnum>::value_variants()
+            .iter()
+            .filter_map(|v| clap::ValueEnum::to_possible_value(v).map(|p| p.get_name().to_string()))
+            .collect();
+        format!(
+            "{name:?} is not a register of the 2020 firmware: give one of {}",
+            names.join(", ")
+        )
+    })
+}
+
+/// The line for a command that has no meaning on v1.0.0.
+fn not_on_v1(command: &str, why: &str) -> String {
+    format!("{command}: this board runs the v1.0.0 firmware, and {why}")
+}
+
+/// A command run from `main` that never reaches `run`.
+fn unreachable_in_run(command: &str) -> Result<(), String> {
+    Err(format!("{command}: its own exit status"))
+}
+
 fn port(cli_port: Option<&str>) -> Result<&str, String> {
     cli_port.ok_or_else(|| "this command talks to a board: give its serial port with --port PATH (or try `chassis sim --pty`)".to_string())
 }
@@ -383,11 +443,12 @@ fn run(cli: Cli) -> Result<(), String> {
                 );
             }
             let data = read_input(file.as_deref())?;
+            let firmware = cli.firmware;
             if let Some(name) = master_analyzer {
                 let (mut board, mut master) = decode::parse_saleae_sides(&data, &name)?;
                 board.quiet_s = quiet;
                 master.quiet_s = quiet;
-                let decoded = decode::decode_both(&board, &master)?;
+                let decoded = decode::decode_both(&board, &master, firmware)?;
                 return write_decoded(&decoded, format);
             }
             let mut capture = decode::read_capture(&data, input)?;
@@ -396,9 +457,9 @@ fn run(cli: Cli) -> Result<(), String> {
                 Some(path) => {
                     let mut master = decode::read_capture(&read_input(Some(&path))?, input)?;
                     master.quiet_s = quiet;
-                    decode::decode_both(&capture, &master)?
+                    decode::decode_both(&capture, &master, firmware)?
                 }
-                None => decode::decode(&capture, uplink),
+                None => decode::decode(&capture, uplink, firmware),
             };
             write_decoded(&decoded, format)
         }
@@ -406,38 +467,134 @@ fn run(cli: Cli) -> Result<(), String> {
             say!("{}", encode::hex(&encode::encode(&frame)?));
             Ok(())
         }
-        Cmd::Get { register } => device::get(port(p)?, register),
+        Cmd::Detect => unreachable_in_run("detect"),
+        Cmd::Get { register } => {
+            let path = port(p)?;
+            match connect::generation(path, cli.firmware)? {
+                Firmware::V2020 => device::get(path, register_2020(&register)?),
+                Firmware::V1_0_0 => v1cmd::get(path, &register),
+            }
+        }
         Cmd::Set {
             register,
             value,
             cutoff,
             yes,
-        } => device::set(port(p)?, register, &value, cutoff.as_deref(), yes),
+        } => {
+            let path = port(p)?;
+            match connect::generation(path, cli.firmware)? {
+                Firmware::V2020 => device::set(
+                    path,
+                    register_2020(&register)?,
+                    &value,
+                    cutoff.as_deref(),
+                    yes,
+                ),
+                Firmware::V1_0_0 if cutoff.is_some() => Err(format!(
+                    "set {register}: one value on v1.0.0 (the cut-off is battery-range's, a 2020 register)"
+                )),
+                Firmware::V1_0_0 => v1cmd::set(path, &register, &value),
+            }
+        }
         Cmd::Settings { save, restore } => {
-            device::settings(port(p)?, save.as_deref(), restore.as_deref())
+            let path = port(p)?;
+            match connect::generation(path, cli.firmware)? {
+                Firmware::V2020 => device::settings(path, save.as_deref(), restore.as_deref()),
+                Firmware::V1_0_0 => v1cmd::settings(path, save.as_deref(), restore.as_deref()),
+            }
         }
-        Cmd::Save => device::save(port(p)?),
-        Cmd::CalibrateGyro => device::calibrate_gyro(port(p)?),
-        Cmd::Stop => device::stop(port(p)?),
-        Cmd::Drive { axes, seconds } => {
-            let (x, y, z) = axes.values()?;
-            device::drive(port(p)?, chassis_protocol::Velocity::new(x, y, z), seconds)
+        Cmd::Save => {
+            let path = port(p)?;
+            match connect::generation(path, cli.firmware)? {
+                Firmware::V2020 => device::save(path),
+                Firmware::V1_0_0 => Err(not_on_v1(
+                    "save",
+                    "v1.0.0 has no frame that stores settings in flash (settings last until power-off: `chassis settings --save FILE` keeps them in a file)",
+                )),
+            }
         }
-        Cmd::Turn { degrees } => device::turn(port(p)?, degrees),
+        Cmd::CalibrateGyro => {
+            let path = port(p)?;
+            match connect::generation(path, cli.firmware)? {
+                Firmware::V2020 => device::calibrate_gyro(path),
+                Firmware::V1_0_0 => Err(not_on_v1(
+                    "calibrate-gyro",
+                    "v1.0.0 has no gyro calibration frame",
+                )),
+            }
+        }
+        Cmd::Stop => {
+            let path = port(p)?;
+            match connect::generation(path, cli.firmware)? {
+                Firmware::V2020 => device::stop(path),
+                Firmware::V1_0_0 => v1cmd::stop(path),
+            }
+        }
+        Cmd::Drive {
+            axes,
+            vx,
+            vy,
+            wz,
+            seconds,
+        } => {
+            let path = port(p)?;
+            let si = vx.is_some() || vy.is_some() || wz.is_some();
+            let raw = [&axes.x, &axes.y, &axes.z]
+                .iter()
+                .any(|v| v.as_str() != "0");
+            match connect::generation(path, cli.firmware)? {
+                Firmware::V2020 if si => Err(
+                    "drive: --vx/--vy/--wz are for the v1.0.0 firmware; this board runs the 2020 one: give --x --y --z (the board's raw units)".into(),
+                ),
+                Firmware::V2020 => {
+                    let (x, y, z) = axes.values()?;
+                    device::drive(path, chassis_protocol::Velocity::new(x, y, z), seconds)
+                }
+                Firmware::V1_0_0 if raw => Err(
+                    "drive: --x/--y/--z are the 2020 firmware's raw units; this board runs v1.0.0: give --vx --vy (m/s) --wz (rad/s)".into(),
+                ),
+                Firmware::V1_0_0 => {
+                    let velocity = chassis_protocol::v1::BodyVelocity::new(
+                        v1cmd::milli(vx.unwrap_or(0.0), "vx", "m/s")?,
+                        v1cmd::milli(vy.unwrap_or(0.0), "vy", "m/s")?,
+                        v1cmd::milli(wz.unwrap_or(0.0), "wz", "rad/s")?,
+                    );
+                    v1cmd::drive(path, velocity, seconds)
+                }
+            }
+        }
+        Cmd::Turn { degrees } => {
+            let path = port(p)?;
+            match connect::generation(path, cli.firmware)? {
+                Firmware::V2020 => device::turn(path, degrees),
+                Firmware::V1_0_0 => Err(not_on_v1(
+                    "turn",
+                    "v1.0.0 has no turn by an angle (its protocol has none): `chassis drive --wz RAD/S --for SECONDS` turns at a rate",
+                )),
+            }
+        }
         Cmd::Monitor { drive, speed } => {
-            let speed = value::parse_i32(&speed, "speed", 1, 65_535)?;
-            monitor::run(port(p)?, drive, speed)
+            let path = port(p)?;
+            match connect::generation(path, cli.firmware)? {
+                Firmware::V2020 => {
+                    let speed = value::parse_i32(&speed, "speed", 1, 65_535)?;
+                    monitor::run(path, drive, speed)
+                }
+                Firmware::V1_0_0 => Err(not_on_v1("monitor", "not yet for v1.0.0")),
+            }
         }
         // Run from `main`: its exit status is the verdict.
-        Cmd::Check { .. } => Err("check: its own exit status".into()),
+        Cmd::Check { .. } => unreachable_in_run("check"),
         Cmd::Record { out, seconds } => record::record(port(p)?, &out, seconds),
         Cmd::Sim {
             pty,
             tcp,
             faults,
             seed,
-            firmware,
         } => {
+            let firmware = cli
+                .firmware
+                .unwrap_or(chassis_protocol::detect::Firmware::V2020);
             let faults = sim::faults(faults)?;
             match (pty, tcp) {
                 (true, _) => sim::pty(firmware, seed, faults),

@@ -22,8 +22,11 @@ pub const BYTE_S: f64 = 10.0 / 115_200.0;
 #[allow(clippy::cast_lossless)]
 pub const QUIET_S: f64 = Config::HOST.idle_ms as f64 / 1000.0;
 
-/// The driver the CLI uses: the host driver over a [`Port`].
+/// The driver the CLI uses for a 2020 board: the host driver over a [`Port`].
 pub type Board = Driver<Port, SharedClock>;
+
+/// The driver the CLI uses for a v1.0.0 board.
+pub type BoardV1 = Driver<Port, SharedClock, chassis_protocol::driver::v1::DriverCore>;
 
 /// The host's monotonic clock, each reading also shown to the [`Port`] (whose recording is
 /// stamped with the times the driver judges by).
@@ -65,10 +68,45 @@ pub fn record_to(path: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// Opens `path` as the board's port with the host defaults; `record`, if given (or set by
+/// Opens `path` as a 2020 board's port with the host defaults; `record`, if given (or set by
 /// [`record_to`]), gets every byte both ways.
 pub fn open(path: &str, record: Option<Recorder>) -> Result<Board, String> {
+    let (port, clock) = open_port(path, record)?;
+    Ok(Driver::new(port, clock, Config::HOST))
+}
+
+/// Opens `path` as a v1.0.0 board's port (as [`open`]).
+pub fn open_v1(path: &str, record: Option<Recorder>) -> Result<BoardV1, String> {
+    let (port, clock) = open_port(path, record)?;
+    Ok(Driver::new_v1(port, clock, Config::HOST))
+}
+
+/// Opens `path` as the board's serial port, with the clock its recording is stamped by.
+pub fn open_port(path: &str, record: Option<Recorder>) -> Result<(Port, SharedClock), String> {
     let record = record.or_else(|| RECORD.lock().ok().and_then(|mut r| r.take()));
+    let port = open_serial(path)?;
+    let record = record.map(|mut r| {
+        r.armed = true;
+        r
+    });
+    let clock = SharedClock {
+        clock: MonotonicClock::new(),
+        last: Rc::new(Cell::new(0)),
+    };
+    Ok((
+        Port {
+            port,
+            path: path.to_string(),
+            now: Rc::clone(&clock.last),
+            record,
+        },
+        clock,
+    ))
+}
+
+/// Opens `path` as a serial port with the host defaults (not recorded): refused clearly when it
+/// is a file, a folder or a device that takes no serial settings.
+pub fn open_serial(path: &str) -> Result<SerialPort, String> {
     if let Ok(meta) = std::fs::metadata(path) {
         if meta.is_file() || meta.is_dir() {
             return Err(format!(
@@ -77,7 +115,7 @@ pub fn open(path: &str, record: Option<Recorder>) -> Result<Board, String> {
             ));
         }
     }
-    let port = SerialPort::open(path).map_err(|e| {
+    SerialPort::open(path).map_err(|e| {
         // ENOTTY, EINVAL: a device that takes no serial settings (/dev/null, /dev/urandom).
         // The serial port crate keeps the OS's words, not its number.
         let text = e.0.to_string();
@@ -90,25 +128,7 @@ pub fn open(path: &str, record: Option<Recorder>) -> Result<Board, String> {
         } else {
             format!("cannot open {path}: {text}")
         }
-    })?;
-    let record = record.map(|mut r| {
-        r.armed = true;
-        r
-    });
-    let clock = SharedClock {
-        clock: MonotonicClock::new(),
-        last: Rc::new(Cell::new(0)),
-    };
-    Ok(Driver::new(
-        Port {
-            port,
-            path: path.to_string(),
-            now: Rc::clone(&clock.last),
-            record,
-        },
-        clock,
-        Config::HOST,
-    ))
+    })
 }
 
 /// The host serial port, with an optional recording of its bytes.

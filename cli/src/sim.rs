@@ -6,23 +6,7 @@ use chassis_protocol::sim::{self, Board, Faults, SimConfig, Simulated, serve};
 use std::net::TcpListener;
 use std::sync::atomic::AtomicBool;
 
-/// The firmware the simulated board runs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Firmware {
-    /// The 2020 firmware (`FF FE` frames, PROTOCOL.md).
-    V2020,
-    /// v1.0.0 (`7B … BCC 7D` frames, PROTOCOL-V1.md).
-    V1,
-}
-
-/// `--firmware`: exactly `2020`, `v1.0.0` or `v1`.
-pub fn firmware(name: &str) -> Result<Firmware, String> {
-    match name {
-        "2020" => Ok(Firmware::V2020),
-        "v1.0.0" | "v1" => Ok(Firmware::V1),
-        _ => Err("the simulated board runs firmware 2020 or v1.0.0 (or v1)".into()),
-    }
-}
+use chassis_protocol::detect::Firmware;
 
 /// Line faults from a rate of errors per byte: a third each dropped, changed and added.
 pub fn faults(rate: f64) -> Result<Faults, String> {
@@ -64,7 +48,7 @@ fn board_v1(seed: u64, faults: Faults) -> sim::v1::Board {
 pub fn pty(firmware: Firmware, seed: u64, faults: Faults) -> Result<(), String> {
     match firmware {
         Firmware::V2020 => on_pty(board(seed, faults), "try `chassis --port {path} settings`"),
-        Firmware::V1 => on_pty(board_v1(seed, faults), "firmware v1.0.0, 7B … 7D frames"),
+        Firmware::V1_0_0 => on_pty(board_v1(seed, faults), "firmware v1.0.0, 7B … 7D frames"),
     }
 }
 
@@ -104,7 +88,7 @@ pub fn pty(_firmware: Firmware, _seed: u64, _faults: Faults) -> Result<(), Strin
 pub fn tcp(addr: &str, firmware: Firmware, seed: u64, faults: Faults) -> Result<(), String> {
     match firmware {
         Firmware::V2020 => on_tcp(addr, || board(seed, faults), Board::commands),
-        Firmware::V1 => on_tcp(
+        Firmware::V1_0_0 => on_tcp(
             addr,
             || board_v1(seed, faults),
             sim::v1::Board::total_commands,

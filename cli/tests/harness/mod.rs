@@ -4,7 +4,7 @@
 
 #![allow(dead_code)]
 
-use chassis_protocol::sim::{Board, Faults, Motion, SimConfig, serve};
+use chassis_protocol::sim::{Board, Faults, Motion, SimConfig, Simulated, serve};
 use chassis_protocol::{Command, UplinkParser};
 use serialport::{SerialPort as _, TTYPort};
 use std::io::{self, Read, Write};
@@ -58,15 +58,16 @@ impl Write for Tap {
     }
 }
 
-/// A simulated board served on a pseudo-terminal in a thread of the test.
-pub struct TestBoard {
+/// A simulated board (the 2020 one unless `B` says) served on a pseudo-terminal in a thread of
+/// the test.
+pub struct TestBoard<B = Board> {
     /// The path the CLI opens.
     pub path: String,
     stop: Arc<AtomicBool>,
     silent: Arc<AtomicBool>,
     drop_replies: Arc<AtomicU32>,
     heard: Arc<Mutex<Vec<u8>>>,
-    thread: Option<JoinHandle<io::Result<Board>>>,
+    thread: Option<JoinHandle<io::Result<B>>>,
     _keep: TTYPort,
 }
 
@@ -78,11 +79,18 @@ impl TestBoard {
 
     /// A board `setup` prepared (faults, registers).
     pub fn with(setup: impl FnOnce(&mut Board)) -> TestBoard {
+        let mut board = Board::new(SimConfig::default());
+        setup(&mut board);
+        TestBoard::serving(board)
+    }
+}
+
+impl<B: Simulated + Send + 'static> TestBoard<B> {
+    /// `board`, served.
+    pub fn serving(board: B) -> TestBoard<B> {
         let (mut board_end, path_end) = TTYPort::pair().expect("a pseudo-terminal");
         board_end.set_timeout(Duration::from_millis(1)).unwrap();
         let path = path_end.name().expect("its path");
-        let mut board = Board::new(SimConfig::default());
-        setup(&mut board);
         let stop = Arc::new(AtomicBool::new(false));
         let silent = Arc::new(AtomicBool::new(false));
         let drop_replies = Arc::new(AtomicU32::new(0));
@@ -121,24 +129,6 @@ impl TestBoard {
         self.heard.lock().unwrap().clone()
     }
 
-    /// The commands the board was sent so far.
-    pub fn commands(&self) -> Vec<Command> {
-        commands(&self.heard())
-    }
-
-    /// Waits (up to 5 s) until the board was sent a command `want` accepts.
-    pub fn wait_for(&self, what: &str, want: impl Fn(&Command) -> bool) {
-        let start = Instant::now();
-        while !self.commands().iter().any(&want) {
-            assert!(
-                start.elapsed() < Duration::from_secs(5),
-                "the board was never sent {what}: {:?}",
-                self.commands()
-            );
-            std::thread::sleep(Duration::from_millis(10));
-        }
-    }
-
     /// `chassis --port PATH args`, run to its end.
     pub fn run(&self, args: &[&str]) -> Output {
         let mut all = vec!["--port", self.path.as_str()];
@@ -160,7 +150,7 @@ impl TestBoard {
     }
 
     /// Stops serving: the board as it ends, and every byte it was sent.
-    pub fn finish(mut self) -> (Board, Vec<u8>) {
+    pub fn finish(mut self) -> (B, Vec<u8>) {
         self.stop.store(true, Ordering::SeqCst);
         let board = self
             .thread
@@ -173,7 +163,27 @@ impl TestBoard {
     }
 }
 
-impl Drop for TestBoard {
+impl TestBoard {
+    /// The commands the board was sent so far.
+    pub fn commands(&self) -> Vec<Command> {
+        commands(&self.heard())
+    }
+
+    /// Waits (up to 5 s) until the board was sent a command `want` accepts.
+    pub fn wait_for(&self, what: &str, want: impl Fn(&Command) -> bool) {
+        let start = Instant::now();
+        while !self.commands().iter().any(&want) {
+            assert!(
+                start.elapsed() < Duration::from_secs(5),
+                "the board was never sent {what}: {:?}",
+                self.commands()
+            );
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    }
+}
+
+impl<B> Drop for TestBoard<B> {
     fn drop(&mut self) {
         self.stop.store(true, Ordering::SeqCst);
         if let Some(t) = self.thread.take() {

@@ -1,0 +1,116 @@
+//! Which firmware the board runs, before a command talks to it: `--firmware` when given, else
+//! [`chassis_protocol::detect`] on the port (it listens first, and only on a quiet line sends
+//! its two harmless probes), and `chassis detect`, which says it in one line.
+
+use crate::port;
+use chassis_protocol::detect::{self, Detection, Firmware, Heard};
+use chassis_protocol::driver::Config;
+use chassis_protocol::driver::host::MonotonicClock;
+
+/// `--firmware`: exactly `2020`, `v1.0.0` or `v1`.
+pub fn firmware_arg(name: &str) -> Result<Firmware, String> {
+    match name {
+        "2020" => Ok(Firmware::V2020),
+        "v1.0.0" | "v1" => Ok(Firmware::V1_0_0),
+        _ => Err("the board runs firmware 2020 or v1.0.0 (or v1)".into()),
+    }
+}
+
+/// Exit status of `chassis detect` when nothing came from the board.
+pub const SILENT: u8 = 3;
+/// Exit status of `chassis detect` when bytes came, but frames of neither generation.
+pub const NEITHER: u8 = 4;
+
+/// Listens on `path` (and probes it if it is quiet).
+fn listen(path: &str) -> Result<Detection, String> {
+    let mut serial = port::open_serial(path)?;
+    let mut clock = MonotonicClock::new();
+    detect::detect(&mut serial, &mut clock, &Config::HOST)
+        .map_err(|e| format!("serial port {path}: {}", e.0))
+}
+
+/// What was heard, in words: the frames, in `seconds`.
+fn heard_words(heard: &Heard, firmware: Firmware, seconds: f64) -> String {
+    match firmware {
+        Firmware::V2020 => format!(
+            "{} frames in {seconds:.1} s{}",
+            heard.frames_2020,
+            match heard.replies_2020 {
+                0 => String::new(),
+                _ => ", among them the answer to a register read".into(),
+            }
+        ),
+        Firmware::V1_0_0 => format!(
+            "{} frames in {seconds:.1} s, each with its BCC right{}{}",
+            heard.frames_v1,
+            match heard.bad_checksum_v1 {
+                0 => String::new(),
+                n => format!(" ({n} more with a wrong BCC: a noisy line?)"),
+            },
+            match heard.replies_v1 {
+                0 => String::new(),
+                _ => ", among them the answer to a readback".into(),
+            }
+        ),
+    }
+}
+
+/// The line `chassis detect` prints when nothing decided.
+fn undecided(path: &str, found: &Detection) -> (String, u8) {
+    let seconds = found.elapsed_ms as f64 / 1000.0;
+    if found.heard.bytes == 0 {
+        (
+            format!(
+                "nothing came from the board on {path} in {seconds:.1} s, not even an answer to a register read of either firmware (is it powered, TX wired to RX and RX to TX, at 115200 bps?)"
+            ),
+            SILENT,
+        )
+    } else {
+        (
+            format!(
+                "{} bytes came from {path} in {seconds:.1} s, but no frame of either firmware (2020: FF FA/FB/FC; v1.0.0: 7B … BCC 7D): another device, or a baud rate other than 115200?",
+                found.heard.bytes
+            ),
+            NEITHER,
+        )
+    }
+}
+
+/// `chassis detect`: one line naming the firmware and what was heard (exit 0), or why none
+/// ([`SILENT`], [`NEITHER`]).
+pub fn detect_command(path: &str) -> Result<(), (String, u8)> {
+    let found = listen(path).map_err(|e| (e, 1))?;
+    let Some(firmware) = found.firmware else {
+        return Err(undecided(path, &found));
+    };
+    say!(
+        "firmware {} ({}) on {path}: heard {}{}",
+        firmware.name(),
+        firmware.framing(),
+        heard_words(&found.heard, firmware, found.elapsed_ms as f64 / 1000.0),
+        if found.probed {
+            " (after a register read of each firmware: the board was quiet)"
+        } else {
+            " (listening only: nothing was sent)"
+        }
+    );
+    Ok(())
+}
+
+/// The firmware a command talks to: `given`, or found on `path`. A line that stays silent is
+/// taken as the 2020 firmware (the command's own error then says what did not answer); bytes of
+/// neither generation are an error.
+pub fn generation(path: &str, given: Option<Firmware>) -> Result<Firmware, String> {
+    if let Some(firmware) = given {
+        return Ok(firmware);
+    }
+    let found = listen(path)?;
+    match found.firmware {
+        Some(firmware) => Ok(firmware),
+        None if found.heard.bytes == 0 => Ok(Firmware::V2020),
+        None => Err(format!(
+            "{}; --firmware 2020|v1.0.0 skips this check",
+            undecided(path, &found).0
+        )),
+    }
+}

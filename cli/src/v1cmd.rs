@@ -1,0 +1,363 @@
+//! The commands on a board running the v1.0.0 firmware (`7B … BCC 7D` frames): `drive --vx
+//! --vy --wz`, `stop` (the forced stop), `get` / `set` over the five readbacks and the three
+//! settings frames, `settings` (save / restore the three). The driver is the same as the 2020
+//! board's, its core the v1.0.0 one: the same failsafe (it sends the forced stop), the same
+//! whole-frame guarantee. What v1.0.0 has no frame for (a turn by an angle, storing in flash, a
+//! gyro calibration) is refused in one line.
+
+use crate::port::{self, BoardV1};
+use crate::signals;
+use chassis_protocol::driver::host::SerialError;
+use chassis_protocol::driver::v1::Settings;
+use chassis_protocol::driver::{CoreError, Error};
+use chassis_protocol::v1::{BodyVelocity, Geometry, Pid, Readback, Reply, SystemSettings};
+use serde::{Deserialize, Serialize};
+use std::time::{Duration, Instant};
+
+/// A readback's name on the command line.
+fn readback_name(r: Readback) -> &'static str {
+    match r {
+        Readback::System => "system",
+        Readback::Geometry => "geometry",
+        Readback::BodyVelocity => "body-velocity",
+        Readback::MotorSpeeds => "motor-speeds",
+        Readback::Pid => "pid",
+    }
+}
+
+/// The settings fields `get` and `set` take, with the readback that holds each.
+const FIELDS: [(&str, Readback); 14] = [
+    ("motor-directions", Readback::System),
+    ("encoder-directions", Readback::System),
+    ("pwm-max", Readback::System),
+    ("pwm-min", Readback::System),
+    ("encoder-ppr", Readback::System),
+    ("wheel-spacing", Readback::Geometry),
+    ("axle-spacing", Readback::Geometry),
+    ("gear-ratio", Readback::Geometry),
+    ("wheel-diameter", Readback::Geometry),
+    ("position-kp", Readback::Pid),
+    ("position-ki", Readback::Pid),
+    ("position-kd", Readback::Pid),
+    ("velocity-kp", Readback::Pid),
+    ("velocity-ki", Readback::Pid),
+];
+
+/// The names `get` takes on v1.0.0, for messages.
+pub fn names() -> String {
+    let frames = Readback::ALL.map(readback_name).join(", ");
+    let fields: Vec<&str> = FIELDS.iter().map(|(n, _)| *n).collect();
+    format!("{frames}, or one field: {}", fields.join(", "))
+}
+
+/// A driver error as one line, in the CLI's words.
+fn explain(driver: &BoardV1, e: Error<SerialError>) -> String {
+    let port = driver.uart().name();
+    let silent = driver.core().last_heard_ms().is_none();
+    match e {
+        Error::Core(CoreError::NoReadback(r)) if silent => format!(
+            "nothing came from the board on {port}: no answer to the readback of {} (is it powered, TX wired to RX and RX to TX, at 115200 bps?)",
+            readback_name(r)
+        ),
+        Error::Core(CoreError::NoReadback(r)) => format!(
+            "the board did not answer the readback of {} (its telemetry arrives: a reply lost on the line?)",
+            readback_name(r)
+        ),
+        Error::Core(CoreError::ReadbackDiffers(r)) => format!(
+            "the {} settings were written, but the board's readback does not show them (it did not take them, or keeps other values)",
+            readback_name(r)
+        ),
+        Error::Transport(e) => format!("serial port {port}: {}", e.0),
+        other => other.to_string(),
+    }
+}
+
+/// One readback.
+fn readback(driver: &mut BoardV1, r: Readback) -> Result<Reply, String> {
+    driver.readback(r).map_err(|e| explain(driver, e))
+}
+
+/// A reply's fields as JSON.
+fn reply_json(reply: &Reply) -> serde_json::Value {
+    let value = match reply.request {
+        Readback::System => reply.system().map(|s| serde_json::to_value(s).ok()),
+        Readback::Geometry => reply.geometry().map(|g| serde_json::to_value(g).ok()),
+        Readback::BodyVelocity => reply.body_velocity().map(|v| serde_json::to_value(v).ok()),
+        Readback::MotorSpeeds => reply.motor_speeds().map(|m| serde_json::to_value(m).ok()),
+        Readback::Pid => reply.pid().map(|p| serde_json::to_value(p).ok()),
+    };
+    value.flatten().unwrap_or(serde_json::Value::Null)
+}
+
+/// A field's value in a reply.
+fn field_of(reply: &Reply, field: &str) -> Option<u16> {
+    let s = reply.system();
+    let g = reply.geometry();
+    let p = reply.pid();
+    Some(match field {
+        "motor-directions" => u16::from(s?.motor_directions),
+        "encoder-directions" => u16::from(s?.encoder_directions),
+        "pwm-max" => s?.pwm_max,
+        "pwm-min" => s?.pwm_min,
+        "encoder-ppr" => s?.encoder_ppr,
+        "wheel-spacing" => g?.wheel_spacing_mm,
+        "axle-spacing" => g?.axle_spacing_mm,
+        "gear-ratio" => g?.gear_ratio,
+        "wheel-diameter" => g?.wheel_diameter_mm,
+        "position-kp" => p?.position_kp,
+        "position-ki" => p?.position_ki,
+        "position-kd" => p?.position_kd,
+        "velocity-kp" => p?.velocity_kp,
+        "velocity-ki" => p?.velocity_ki,
+        _ => return None,
+    })
+}
+
+/// The settings of `reply` with `field` set to `value` (range-checked).
+fn with_field(reply: &Reply, field: &str, value: u16) -> Result<Settings, String> {
+    let byte = || {
+        u8::try_from(value)
+            .map_err(|_| format!("{field}: {value} is out of range (0..=255, a bit field)"))
+    };
+    if let Some(mut s) = reply.system() {
+        match field {
+            "motor-directions" => s.motor_directions = byte()?,
+            "encoder-directions" => s.encoder_directions = byte()?,
+            "pwm-max" => s.pwm_max = value,
+            "pwm-min" => s.pwm_min = value,
+            "encoder-ppr" => s.encoder_ppr = value,
+            _ => return Err(format!("{field} is not a system setting")),
+        }
+        return Ok(Settings::System(s));
+    }
+    if let Some(mut g) = reply.geometry() {
+        match field {
+            "wheel-spacing" => g.wheel_spacing_mm = value,
+            "axle-spacing" => g.axle_spacing_mm = value,
+            "gear-ratio" => g.gear_ratio = value,
+            "wheel-diameter" => g.wheel_diameter_mm = value,
+            _ => return Err(format!("{field} is not a geometry setting")),
+        }
+        return Ok(Settings::Geometry(g));
+    }
+    if let Some(mut p) = reply.pid() {
+        match field {
+            "position-kp" => p.position_kp = value,
+            "position-ki" => p.position_ki = value,
+            "position-kd" => p.position_kd = value,
+            "velocity-kp" => p.velocity_kp = value,
+            "velocity-ki" => p.velocity_ki = value,
+            _ => return Err(format!("{field} is not a PID gain")),
+        }
+        return Ok(Settings::Pid(p));
+    }
+    Err(format!("{field} cannot be written"))
+}
+
+/// `chassis get NAME` on v1.0.0: a whole readback as JSON, or one field.
+pub fn get(path: &str, name: &str) -> Result<(), String> {
+    let frame = Readback::ALL
+        .into_iter()
+        .find(|r| readback_name(*r) == name);
+    let field = FIELDS.iter().find(|(n, _)| *n == name);
+    let request = match (frame, field) {
+        (Some(r), _) => r,
+        (None, Some((_, r))) => *r,
+        (None, None) => {
+            return Err(format!(
+                "{name:?} is not a v1.0.0 setting: give {}",
+                names()
+            ));
+        }
+    };
+    let mut driver = port::open_v1(path, None)?;
+    let reply = readback(&mut driver, request)?;
+    match field {
+        Some((n, _)) => {
+            let value = field_of(&reply, n).ok_or_else(|| format!("no {n} in the reply"))?;
+            say!("{n}: {value}");
+        }
+        None => say!("{}", reply_json(&reply)),
+    }
+    Ok(())
+}
+
+/// `chassis set FIELD VALUE` on v1.0.0: reads the settings frame that holds FIELD, writes it
+/// back with FIELD changed, and confirms it by a readback.
+pub fn set(path: &str, name: &str, value: &str) -> Result<(), String> {
+    let Some((field, request)) = FIELDS.iter().find(|(n, _)| *n == name).copied() else {
+        return Err(format!(
+            "{name:?} is not a v1.0.0 setting that can be written: give one of {}",
+            FIELDS.map(|(n, _)| n).join(", ")
+        ));
+    };
+    let value = i64::from(crate::value::parse_i32(
+        value,
+        field,
+        0,
+        i64::from(u16::MAX),
+    )?);
+    let value = u16::try_from(value).map_err(|_| format!("{field}: {value} is out of range"))?;
+    let mut driver = port::open_v1(path, None)?;
+    let reply = readback(&mut driver, request)?;
+    let settings = with_field(&reply, field, value)?;
+    driver
+        .write_settings(settings)
+        .map_err(|e| explain(&driver, e))?;
+    say!("{field}: {value} (written and read back)");
+    Ok(())
+}
+
+/// The three settings frames of a v1.0.0 board, as `settings --save` writes them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Saved {
+    /// Always "v1.0.0": a file of the other generation is refused.
+    firmware: Mark,
+    system: SystemSettings,
+    geometry: Geometry,
+    pid: Pid,
+}
+
+/// The firmware mark of a settings file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+enum Mark {
+    /// v1.0.0.
+    #[serde(rename = "v1.0.0")]
+    V1,
+}
+
+/// `chassis settings [--save FILE | --restore FILE]` on v1.0.0.
+pub fn settings(path: &str, save: Option<&str>, restore: Option<&str>) -> Result<(), String> {
+    if let Some(file) = restore {
+        let text = std::fs::read_to_string(file).map_err(|e| format!("cannot read {file}: {e}"))?;
+        let saved: Saved = serde_json::from_str(&text).map_err(|e| {
+            format!("{file} is not a v1.0.0 settings file (`chassis settings --save` on a v1.0.0 board writes one): {e}")
+        })?;
+        let mut driver = port::open_v1(path, None)?;
+        for settings in [
+            Settings::System(saved.system),
+            Settings::Geometry(saved.geometry),
+            Settings::Pid(saved.pid),
+        ] {
+            driver.write_settings(settings).map_err(|e| {
+                format!(
+                    "{} (the frames before it were written and confirmed)",
+                    explain(&driver, e)
+                )
+            })?;
+        }
+        say!(
+            "restored from {file}: system, geometry and PID written, each confirmed by its readback (v1.0.0 stores nothing in flash: they last until power-off)"
+        );
+        return Ok(());
+    }
+    // A file that cannot be written fails before the board is asked anything.
+    let out = save.map(crate::newfile::NewFile::create).transpose()?;
+    let mut driver = port::open_v1(path, None)?;
+    let system = readback(&mut driver, Readback::System)?.system();
+    let geometry = readback(&mut driver, Readback::Geometry)?.geometry();
+    let pid = readback(&mut driver, Readback::Pid)?.pid();
+    let (Some(system), Some(geometry), Some(pid)) = (system, geometry, pid) else {
+        return Err("a readback came back as another frame".into());
+    };
+    let saved = Saved {
+        firmware: Mark::V1,
+        system,
+        geometry,
+        pid,
+    };
+    let json = serde_json::to_string_pretty(&saved).map_err(|e| e.to_string())?;
+    match out {
+        Some(mut file) => {
+            use std::io::Write as _;
+            let path = file.path().to_string();
+            writeln!(file, "{json}").map_err(|e| format!("cannot write {path}: {e}"))?;
+            file.commit()?;
+            tell!("saved to {path}");
+        }
+        None => say!("{json}"),
+    }
+    Ok(())
+}
+
+/// `chassis stop` on v1.0.0: the forced stop.
+pub fn stop(path: &str) -> Result<(), String> {
+    let mut driver = port::open_v1(path, None)?;
+    driver.stop().map_err(|e| explain(&driver, e))?;
+    say!("stopped (the forced stop was sent)");
+    Ok(())
+}
+
+/// A speed in m/s (or rad/s) as the board's thousandths, range-checked.
+pub fn milli(value: f64, name: &str, unit: &str) -> Result<i16, String> {
+    let m = (value * 1000.0).round();
+    if !m.is_finite() || !(f64::from(i16::MIN)..=f64::from(i16::MAX)).contains(&m) {
+        return Err(format!(
+            "--{name}: {value} {unit} is out of range (±32.767, the frame's 16 bits in thousandths)"
+        ));
+    }
+    Ok(m as i16)
+}
+
+/// `chassis drive --vx --vy --wz --for S` on v1.0.0: the velocity re-sent every 50 ms, then
+/// the forced stop; on a signal, the forced stop at once.
+pub fn drive(path: &str, velocity: BodyVelocity, seconds: f64) -> Result<(), String> {
+    if !(0.0..=600.0).contains(&seconds) {
+        return Err(format!("--for: {seconds} s is out of range (0..=600)"));
+    }
+    let seconds = seconds + 0.0;
+    signals::install()?;
+    let mut driver = port::open_v1(path, None)?;
+    let start = Instant::now();
+    let end = start + Duration::from_secs_f64(seconds);
+    let ended = (|| -> Result<String, String> {
+        let mut next = Instant::now();
+        while Instant::now() < end {
+            if signals::caught().is_some() {
+                return Err("the drive was cut short".into());
+            }
+            if Instant::now() >= next {
+                driver
+                    .set_velocity(velocity)
+                    .map_err(|e| explain(&driver, e))?;
+                next += Duration::from_millis(50);
+            }
+            if driver.poll().map_err(|e| explain(&driver, e))?.is_none() {
+                std::thread::sleep(Duration::from_millis(2));
+            }
+            if driver.core().failsafe_stops() > 0 {
+                return Err(if driver.core().last_heard_ms().is_none() {
+                    format!(
+                        "nothing came from the board on {path} (is it powered, TX wired to RX and RX to TX, at 115200 bps?): the driver's failsafe sent the forced stop"
+                    )
+                } else {
+                    "the board went quiet while driving: the driver's failsafe sent the forced stop"
+                        .into()
+                });
+            }
+        }
+        Ok(format!("drove {seconds} s, stopped (forced stop)"))
+    })();
+    let stopped = driver.stop().map_err(|e| explain(&driver, e));
+    if let Some(signal) = signals::caught() {
+        return Err(match stopped {
+            Ok(()) => format!(
+                "interrupted by {}: the chassis was stopped (the forced stop was sent)",
+                signals::name(signal)
+            ),
+            Err(e) => format!(
+                "interrupted by {}: the forced stop could not be sent: {e}",
+                signals::name(signal)
+            ),
+        });
+    }
+    match (ended, stopped) {
+        (Ok(line), Ok(())) => {
+            say!("{line}");
+            Ok(())
+        }
+        (Err(e), Ok(())) => Err(format!("{e}; the chassis was stopped")),
+        (_, Err(e)) => Err(format!("the forced stop could not be sent: {e}")),
+    }
+}

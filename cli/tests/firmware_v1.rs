@@ -1,0 +1,237 @@
+//! The CLI on a board running the v1.0.0 firmware, served on a real pseudo-terminal: `detect`
+//! on both generations, a silent line and bytes of neither; `drive` stopped at its end and on
+//! every signal; `turn` refused with nothing sent; `get` / `set` / `settings` over the
+//! readbacks and the settings frames. The frames the board must receive are written by hand
+//! from PROTOCOL-V1.md (BCC = XOR of the bytes before it).
+
+mod harness;
+
+use chassis_protocol::sim::v1::{Board, SimConfig};
+use harness::{TestBoard, signal, wait};
+use serialport::{SerialPort as _, TTYPort};
+use std::time::{Duration, Instant};
+
+/// `0x25` forced stop: ctl 0, all zeros; BCC 7B ^ 25 = 5E.
+const FORCED_STOP: [u8; 14] = [0x7B, 0x25, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x5E, 0x7D];
+/// `0x25`: vy 0.3 m/s = 300 mm/s (01 2C), ctl 2, type 4; BCC 7B^25^02^04^01^2C = 75.
+const FORWARD: [u8; 14] = [
+    0x7B, 0x25, 0x02, 0x04, 0, 0, 0x01, 0x2C, 0, 0, 0, 0, 0x75, 0x7D,
+];
+
+fn v1_board() -> TestBoard<Board> {
+    TestBoard::serving(Board::new(SimConfig::default()))
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// The heard bytes as 14-byte frames (each must be whole).
+fn frames(heard: &[u8]) -> Vec<[u8; 14]> {
+    assert_eq!(heard.len() % 14, 0, "only whole frames: {heard:02X?}");
+    heard
+        .chunks(14)
+        .map(|c| <[u8; 14]>::try_from(c).unwrap())
+        .collect()
+}
+
+#[test]
+fn detect_names_each_generation_and_sends_nothing_to_a_streaming_board() {
+    let v1 = v1_board();
+    let out = v1.run(&["detect"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let line = text(&out.stdout);
+    assert!(line.contains("v1.0.0"), "{line}");
+    assert!(line.contains("nothing was sent"), "{line}");
+    let (_, heard) = v1.finish();
+    assert!(heard.is_empty(), "detect sent {heard:02X?}");
+
+    let old = TestBoard::start();
+    let out = old.run(&["detect"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let line = text(&out.stdout);
+    assert!(line.contains("firmware 2020"), "{line}");
+    let (_, heard) = old.finish();
+    assert!(heard.is_empty(), "detect sent {heard:02X?}");
+}
+
+#[test]
+fn detect_on_a_silent_line_sends_only_the_probes_and_says_so_within_seconds() {
+    let (mut board_end, path_end) = TTYPort::pair().unwrap();
+    board_end.set_timeout(Duration::from_millis(50)).unwrap();
+    let path = path_end.name().unwrap();
+    let start = Instant::now();
+    let out = harness::chassis(&["--port", &path, "detect"]);
+    assert!(start.elapsed() < Duration::from_secs(5));
+    assert_eq!(out.status.code(), Some(3), "{}", text(&out.stderr));
+    let line = text(&out.stderr);
+    assert!(line.contains("nothing came from the board"), "{line}");
+    assert_eq!(line.lines().count(), 1, "{line}");
+    let mut heard = Vec::new();
+    let mut buf = [0u8; 64];
+    while let Ok(n) = std::io::Read::read(&mut board_end, &mut buf) {
+        if n == 0 {
+            break;
+        }
+        heard.extend_from_slice(&buf[..n]);
+    }
+    // The 2020 read of the motor voltage (2C) and the vendor's v1.0.0 readback 0x33.
+    let mut probes = vec![0xFF, 0xFE, 0x80, 0x80, 0x1B, 0, 0, 0, 0, 0];
+    probes.extend([0x7B, 0x33, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x48, 0x7D]);
+    assert_eq!(heard, probes);
+}
+
+#[test]
+fn detect_on_bytes_of_neither_generation_says_so() {
+    let (mut board_end, path_end) = TTYPort::pair().unwrap();
+    board_end.set_timeout(Duration::from_millis(1)).unwrap();
+    let path = path_end.name().unwrap();
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let flag = stop.clone();
+    // Another device: a steady stream of ASCII text (no FF, no 7B).
+    let talker = std::thread::spawn(move || {
+        while !flag.load(std::sync::atomic::Ordering::SeqCst) {
+            let _ = std::io::Write::write(&mut board_end, b"temperature=21.5C\r\n");
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    });
+    let out = harness::chassis(&["--port", &path, "detect"]);
+    stop.store(true, std::sync::atomic::Ordering::SeqCst);
+    talker.join().unwrap();
+    drop(path_end);
+    assert_eq!(out.status.code(), Some(4), "{}", text(&out.stderr));
+    let line = text(&out.stderr);
+    assert!(line.contains("no frame of either firmware"), "{line}");
+    // A command then refuses to guess.
+}
+
+#[test]
+fn drive_on_v1_sends_the_velocity_then_the_forced_stop() {
+    let board = v1_board();
+    let out = board.run(&["drive", "--vy", "0.3", "--for", "1"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (board, heard) = board.finish();
+    let frames = frames(&heard);
+    assert!(frames.len() >= 15, "{} frames in 1 s", frames.len());
+    assert!(frames[..frames.len() - 1].iter().all(|f| *f == FORWARD));
+    assert_eq!(frames.last(), Some(&FORCED_STOP));
+    assert_eq!(
+        board.velocity(),
+        chassis_protocol::v1::BodyVelocity::FORCED_STOP
+    );
+}
+
+#[test]
+fn drive_on_v1_is_stopped_by_every_signal() {
+    for (name, number) in [("INT", 2), ("TERM", 15), ("HUP", 1)] {
+        let board = v1_board();
+        let child = board.spawn(&["drive", "--vy", "0.3", "--for", "30"]);
+        let start = Instant::now();
+        while !board.heard().windows(14).any(|w| w == FORWARD) {
+            assert!(start.elapsed() < Duration::from_secs(5), "never drove");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        std::thread::sleep(Duration::from_millis(200));
+        signal(&child, name);
+        let out = wait(child, 10);
+        assert_eq!(out.status.code(), Some(128 + number), "SIG{name}");
+        assert!(
+            text(&out.stderr).contains("the chassis was stopped"),
+            "{}",
+            text(&out.stderr)
+        );
+        let (board, heard) = board.finish();
+        assert_eq!(frames(&heard).last(), Some(&FORCED_STOP), "SIG{name}");
+        assert_eq!(
+            board.velocity(),
+            chassis_protocol::v1::BodyVelocity::FORCED_STOP
+        );
+    }
+}
+
+#[test]
+fn the_2020_axes_and_turn_are_refused_on_v1_with_nothing_sent() {
+    let board = v1_board();
+    for args in [
+        &["turn", "90"][..],
+        &["drive", "--y", "300", "--for", "1"],
+        &["save"],
+        &["calibrate-gyro"],
+        &["get", "max-speed"],
+    ] {
+        let out = board.run(args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let line = text(&out.stderr);
+        assert_eq!(line.lines().count(), 1, "{args:?}: {line}");
+    }
+    let out = board.run(&["turn", "90"]);
+    assert!(text(&out.stderr).contains("no turn by an angle"));
+    let (_, heard) = board.finish();
+    assert!(heard.is_empty(), "sent {heard:02X?}");
+    // And the v1.0.0 axes on a 2020 board.
+    let old = TestBoard::start();
+    let out = old.run(&["drive", "--vy", "0.3", "--for", "1"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("--x --y --z"));
+    let (_, heard) = old.finish();
+    assert!(heard.is_empty());
+}
+
+#[test]
+fn get_set_and_settings_round_trip_on_v1() {
+    let board = v1_board();
+    let out = board.run(&["get", "wheel-diameter"]);
+    assert_eq!(text(&out.stdout).trim(), "wheel-diameter: 60");
+    let out = board.run(&["set", "wheel-diameter", "65"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = board.run(&["get", "geometry"]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["wheel_diameter_mm"], 65);
+    assert_eq!(json["wheel_spacing_mm"], 110, "the rest of the frame kept");
+
+    let dir = std::env::temp_dir().join(format!("chassis-v1-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("settings.json");
+    let file = file.to_str().unwrap();
+    let out = board.run(&["settings", "--save", file]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let saved = std::fs::read_to_string(file).unwrap();
+    assert!(saved.contains("\"firmware\": \"v1.0.0\""), "{saved}");
+    let out = board.run(&["set", "pwm-max", "3000"]);
+    assert!(out.status.success());
+    let out = board.run(&["settings", "--restore", file]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (board, heard) = board.finish();
+    assert_eq!(board.system().pwm_max, 3600, "restored");
+    assert_eq!(board.geometry().wheel_diameter_mm, 65);
+    // Writes: the two sets, then the restore's three frames, nothing else.
+    let written: Vec<u8> = frames(&heard)
+        .iter()
+        .map(|f| f[1])
+        .filter(|c| [0x23, 0x24, 0x40].contains(c))
+        .collect();
+    assert_eq!(written, vec![0x24, 0x23, 0x23, 0x24, 0x40]);
+    let _ = std::fs::remove_dir_all(&dir);
+
+    // A 2020 settings file is refused on v1.0.0, nothing written.
+    let other = dir.join("old.json");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(&other, "{\"max_speed\": 1000}").unwrap();
+    let board = v1_board();
+    let out = board.run(&["settings", "--restore", other.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out.stderr).contains("not a v1.0.0 settings file"));
+    let (_, heard) = board.finish();
+    assert!(heard.is_empty());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn firmware_given_skips_detection() {
+    // A v1.0.0 board told it is 2020: the 2020 read goes out (nothing decides for the user).
+    let board = v1_board();
+    let out = board.run(&["--firmware", "v1.0.0", "stop"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (_, heard) = board.finish();
+    assert_eq!(frames(&heard), vec![FORCED_STOP]);
+}
