@@ -5,11 +5,11 @@
 use chassis_host_tests::channel::{Noise, transmit};
 use chassis_host_tests::{BoardStream, pieces};
 use chassis_protocol::parse::downlink::FORGET_AFTER;
-use chassis_protocol::{detect, v1};
 use chassis_protocol::{
     Action, Battery, Command, Downlink, DownlinkParser, Encoders, Imu, Kind, Motors, Register,
     Reply, Setting, SystemMode, Turn, UplinkParser, Velocity, Write,
 };
+use chassis_protocol::{detect, v1};
 use proptest::prelude::*;
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
