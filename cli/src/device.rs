@@ -32,35 +32,9 @@ pub fn explain(driver: &Board, e: Error<SerialError>) -> String {
 }
 
 /// The driver's logic error `e` in the CLI's words (`silent`: nothing at all came from the
-/// board on `port`). Shared by every command and `chassis check`.
+/// board on `port`). Shared by every command and `chassis check` (and the Python package).
 pub fn core_words(e: CoreError, silent: bool, port: &str) -> String {
-    match e {
-        CoreError::Timeout(r) | CoreError::Unconfirmed(r) if silent => format!(
-            "nothing came from the board on {port}: no answer to the read of {} (is it powered, TX wired to RX and RX to TX, at 115200 bps?)",
-            register_name(r)
-        ),
-        CoreError::Timeout(r) => format!(
-            "the board did not answer the read of {} (its telemetry arrives: a reply lost on the line?)",
-            register_name(r)
-        ),
-        CoreError::Unconfirmed(r) => format!(
-            "the read of {} was not confirmed: its replies went missing or disagreed, while its telemetry arrives (a noisy line?)",
-            register_name(r)
-        ),
-        CoreError::WrongReply { expected, got } => format!(
-            "a reply with code {got:#04x} came while reading {}",
-            register_name(expected)
-        ),
-        CoreError::Invalid { register, value } => format!(
-            "a damaged reply: {value:#010x} cannot be {}'s value",
-            register_name(register)
-        ),
-        CoreError::TurnInProgress => {
-            "the board still has a turn pending (it adds turns up): `chassis stop` cancels it"
-                .into()
-        }
-        other => other.to_string(),
-    }
+    chassis_protocol::driver::host::words(e, silent, port)
 }
 
 /// Reads `register` until two replies agree; its raw value.

@@ -42,36 +42,9 @@ impl RegisterName {
         }
     }
 
-    /// The name of `register` on the command line (for messages).
-    pub fn of(register: Register) -> Option<RegisterName> {
-        [
-            RegisterName::MaxSpeed,
-            RegisterName::Kp,
-            RegisterName::Ki,
-            RegisterName::GyroGain,
-            RegisterName::SystemMode,
-            RegisterName::GyroCalibration,
-            RegisterName::MotorVoltage,
-            RegisterName::BatteryRange,
-            RegisterName::PendingAngle,
-        ]
-        .into_iter()
-        .find(|n| n.register() == register)
-    }
-
     /// Its name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            RegisterName::MaxSpeed => "max-speed",
-            RegisterName::Kp => "kp",
-            RegisterName::Ki => "ki",
-            RegisterName::GyroGain => "gyro-gain",
-            RegisterName::SystemMode => "system-mode",
-            RegisterName::GyroCalibration => "gyro-calibration",
-            RegisterName::MotorVoltage => "motor-voltage",
-            RegisterName::BatteryRange => "battery-range",
-            RegisterName::PendingAngle => "pending-angle",
-        }
+    pub const fn name(self) -> &'static str {
+        self.register().name()
     }
 }
 
@@ -106,10 +79,7 @@ impl ActionName {
     }
 }
 
-/// `register`'s name on the command line ("max-speed"), or its code.
+/// `register`'s name on the command line ("max-speed").
 pub fn register_name(register: Register) -> String {
-    RegisterName::of(register).map_or_else(
-        || format!("register {:#04x}", register.code()),
-        |n| n.name().to_string(),
-    )
+    register.name().to_string()
 }

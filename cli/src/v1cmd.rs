@@ -9,7 +9,7 @@ use crate::port::{self, BoardV1};
 use crate::signals;
 use chassis_protocol::driver::host::SerialError;
 use chassis_protocol::driver::v1::Settings;
-use chassis_protocol::driver::{CoreError, Error};
+use chassis_protocol::driver::Error;
 use chassis_protocol::v1::{BodyVelocity, Geometry, Pid, Readback, Reply, SystemSettings};
 use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
@@ -55,18 +55,7 @@ fn explain(driver: &BoardV1, e: Error<SerialError>) -> String {
     let port = driver.uart().name();
     let silent = driver.core().last_heard_ms().is_none();
     match e {
-        Error::Core(CoreError::NoReadback(r)) if silent => format!(
-            "nothing came from the board on {port}: no answer to the readback of {} (is it powered, TX wired to RX and RX to TX, at 115200 bps?)",
-            readback_name(r)
-        ),
-        Error::Core(CoreError::NoReadback(r)) => format!(
-            "the board did not answer the readback of {} (its telemetry arrives: a reply lost on the line?)",
-            readback_name(r)
-        ),
-        Error::Core(CoreError::ReadbackDiffers(r)) => format!(
-            "the {} settings were written, but the board's readback does not show them (it did not take them, or keeps other values)",
-            readback_name(r)
-        ),
+        Error::Core(e) => crate::device::core_words(e, silent, port),
         Error::Transport(e) => format!("serial port {port}: {}", e.0),
         other => other.to_string(),
     }

@@ -74,6 +74,30 @@ code_enum! {
 }
 
 impl Register {
+    /// Its name as the `chassis` command and the Python package spell it (`max-speed`, `kp`,
+    /// `ki`, `gyro-gain`, `system-mode`, `gyro-calibration`, `motor-voltage`, `battery-range`,
+    /// `pending-angle`).
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Register::MaxSpeed => "max-speed",
+            Register::SpeedKp => "kp",
+            Register::SpeedKi => "ki",
+            Register::GyroGain => "gyro-gain",
+            Register::SystemMode => "system-mode",
+            Register::GyroCalibration => "gyro-calibration",
+            Register::MotorVoltage => "motor-voltage",
+            Register::BatteryRange => "battery-range",
+            Register::PendingAngle => "pending-angle",
+        }
+    }
+
+    /// The register of a [`name`](Register::name).
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        Register::ALL.into_iter().find(|r| r.name() == name)
+    }
+
     /// The code that reads it: `0x10 +` its code (2C), `0x20` for the pending angle (2D).
     #[must_use]
     pub const fn read_code(self) -> u8 {
@@ -351,6 +375,29 @@ mod tests {
     use crate::DriveType;
 
     /// Golden frames, byte for byte from the tables of 2A, 2B, 2C and 2D.
+    #[test]
+    fn register_names_are_the_cli_spellings_and_round_trip() {
+        let names = Register::ALL.map(Register::name);
+        assert_eq!(
+            names,
+            [
+                "max-speed",
+                "kp",
+                "ki",
+                "gyro-gain",
+                "system-mode",
+                "gyro-calibration",
+                "motor-voltage",
+                "battery-range",
+                "pending-angle",
+            ]
+        );
+        for r in Register::ALL {
+            assert_eq!(Register::from_name(r.name()), Some(r));
+        }
+        assert_eq!(Register::from_name("max_speed"), None);
+    }
+
     #[test]
     fn actions_golden() {
         let cases = [

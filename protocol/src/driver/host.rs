@@ -200,3 +200,59 @@ pub fn open(path: &str) -> Result<HostDriver, SerialError> {
     let port = SerialPort::open(path)?;
     Ok(Driver::new(port, MonotonicClock::new(), Config::HOST))
 }
+
+/// A driver error in the words of the `chassis` command (and of the Python package), for a
+/// person: `silent` says nothing at all came from the board on `port` (then, and only then, the
+/// words ask about power and wiring).
+#[must_use]
+pub fn words(e: super::CoreError, silent: bool, port: &str) -> String {
+    use super::CoreError;
+    use crate::v1::Readback;
+    let readback = |r: Readback| match r {
+        Readback::System => "system",
+        Readback::Geometry => "geometry",
+        Readback::BodyVelocity => "body-velocity",
+        Readback::MotorSpeeds => "motor-speeds",
+        Readback::Pid => "pid",
+    };
+    const WIRING: &str = "is it powered, TX wired to RX and RX to TX, at 115200 bps?";
+    match e {
+        CoreError::Timeout(r) | CoreError::Unconfirmed(r) if silent => format!(
+            "nothing came from the board on {port}: no answer to the read of {} ({WIRING})",
+            r.name()
+        ),
+        CoreError::Timeout(r) => format!(
+            "the board did not answer the read of {} (its telemetry arrives: a reply lost on the line?)",
+            r.name()
+        ),
+        CoreError::Unconfirmed(r) => format!(
+            "the read of {} was not confirmed: its replies went missing or disagreed, while its telemetry arrives (a noisy line?)",
+            r.name()
+        ),
+        CoreError::WrongReply { expected, got } => format!(
+            "a reply with code {got:#04x} came while reading {}",
+            expected.name()
+        ),
+        CoreError::Invalid { register, value } => format!(
+            "a damaged reply: {value:#010x} cannot be {}'s value",
+            register.name()
+        ),
+        CoreError::TurnInProgress => {
+            "the board still has a turn pending (it adds turns up): `chassis stop` cancels it"
+                .into()
+        }
+        CoreError::NoReadback(r) if silent => format!(
+            "nothing came from the board on {port}: no answer to the readback of {} ({WIRING})",
+            readback(r)
+        ),
+        CoreError::NoReadback(r) => format!(
+            "the board did not answer the readback of {} (its telemetry arrives: a reply lost on the line?)",
+            readback(r)
+        ),
+        CoreError::ReadbackDiffers(r) => format!(
+            "the {} settings were written, but the board's readback does not show them (it did not take them, or keeps other values)",
+            readback(r)
+        ),
+        other => other.to_string(),
+    }
+}
