@@ -10,42 +10,15 @@ use crate::signals;
 use chassis_protocol::driver::host::SerialError;
 use chassis_protocol::driver::v1::Settings;
 use chassis_protocol::driver::Error;
-use chassis_protocol::v1::{BodyVelocity, Geometry, Pid, Readback, Reply, SystemSettings};
+use chassis_protocol::v1::{
+    BodyVelocity, FIELDS, FieldError, Geometry, Pid, Readback, Reply, SystemSettings,
+};
 use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 
-/// A readback's name on the command line.
-fn readback_name(r: Readback) -> &'static str {
-    match r {
-        Readback::System => "system",
-        Readback::Geometry => "geometry",
-        Readback::BodyVelocity => "body-velocity",
-        Readback::MotorSpeeds => "motor-speeds",
-        Readback::Pid => "pid",
-    }
-}
-
-/// The settings fields `get` and `set` take, with the readback that holds each.
-const FIELDS: [(&str, Readback); 14] = [
-    ("motor-directions", Readback::System),
-    ("encoder-directions", Readback::System),
-    ("pwm-max", Readback::System),
-    ("pwm-min", Readback::System),
-    ("encoder-ppr", Readback::System),
-    ("wheel-spacing", Readback::Geometry),
-    ("axle-spacing", Readback::Geometry),
-    ("gear-ratio", Readback::Geometry),
-    ("wheel-diameter", Readback::Geometry),
-    ("position-kp", Readback::Pid),
-    ("position-ki", Readback::Pid),
-    ("position-kd", Readback::Pid),
-    ("velocity-kp", Readback::Pid),
-    ("velocity-ki", Readback::Pid),
-];
-
 /// The names `get` takes on v1.0.0, for messages.
 pub fn names() -> String {
-    let frames = Readback::ALL.map(readback_name).join(", ");
+    let frames = Readback::ALL.map(Readback::name).join(", ");
     let fields: Vec<&str> = FIELDS.iter().map(|(n, _)| *n).collect();
     format!("{frames}, or one field: {}", fields.join(", "))
 }
@@ -78,76 +51,9 @@ fn reply_json(reply: &Reply) -> serde_json::Value {
     value.flatten().unwrap_or(serde_json::Value::Null)
 }
 
-/// A field's value in a reply.
-fn field_of(reply: &Reply, field: &str) -> Option<u16> {
-    let s = reply.system();
-    let g = reply.geometry();
-    let p = reply.pid();
-    Some(match field {
-        "motor-directions" => u16::from(s?.motor_directions),
-        "encoder-directions" => u16::from(s?.encoder_directions),
-        "pwm-max" => s?.pwm_max,
-        "pwm-min" => s?.pwm_min,
-        "encoder-ppr" => s?.encoder_ppr,
-        "wheel-spacing" => g?.wheel_spacing_mm,
-        "axle-spacing" => g?.axle_spacing_mm,
-        "gear-ratio" => g?.gear_ratio,
-        "wheel-diameter" => g?.wheel_diameter_mm,
-        "position-kp" => p?.position_kp,
-        "position-ki" => p?.position_ki,
-        "position-kd" => p?.position_kd,
-        "velocity-kp" => p?.velocity_kp,
-        "velocity-ki" => p?.velocity_ki,
-        _ => return None,
-    })
-}
-
-/// The settings of `reply` with `field` set to `value` (range-checked).
-fn with_field(reply: &Reply, field: &str, value: u16) -> Result<Settings, String> {
-    let byte = || {
-        u8::try_from(value)
-            .map_err(|_| format!("{field}: {value} is out of range (0..=255, a bit field)"))
-    };
-    if let Some(mut s) = reply.system() {
-        match field {
-            "motor-directions" => s.motor_directions = byte()?,
-            "encoder-directions" => s.encoder_directions = byte()?,
-            "pwm-max" => s.pwm_max = value,
-            "pwm-min" => s.pwm_min = value,
-            "encoder-ppr" => s.encoder_ppr = value,
-            _ => return Err(format!("{field} is not a system setting")),
-        }
-        return Ok(Settings::System(s));
-    }
-    if let Some(mut g) = reply.geometry() {
-        match field {
-            "wheel-spacing" => g.wheel_spacing_mm = value,
-            "axle-spacing" => g.axle_spacing_mm = value,
-            "gear-ratio" => g.gear_ratio = value,
-            "wheel-diameter" => g.wheel_diameter_mm = value,
-            _ => return Err(format!("{field} is not a geometry setting")),
-        }
-        return Ok(Settings::Geometry(g));
-    }
-    if let Some(mut p) = reply.pid() {
-        match field {
-            "position-kp" => p.position_kp = value,
-            "position-ki" => p.position_ki = value,
-            "position-kd" => p.position_kd = value,
-            "velocity-kp" => p.velocity_kp = value,
-            "velocity-ki" => p.velocity_ki = value,
-            _ => return Err(format!("{field} is not a PID gain")),
-        }
-        return Ok(Settings::Pid(p));
-    }
-    Err(format!("{field} cannot be written"))
-}
-
 /// `chassis get NAME` on v1.0.0: a whole readback as JSON, or one field.
 pub fn get(path: &str, name: &str) -> Result<(), String> {
-    let frame = Readback::ALL
-        .into_iter()
-        .find(|r| readback_name(*r) == name);
+    let frame = Readback::from_name(name);
     let field = FIELDS.iter().find(|(n, _)| *n == name);
     let request = match (frame, field) {
         (Some(r), _) => r,
@@ -163,7 +69,7 @@ pub fn get(path: &str, name: &str) -> Result<(), String> {
     let reply = readback(&mut driver, request)?;
     match field {
         Some((n, _)) => {
-            let value = field_of(&reply, n).ok_or_else(|| format!("no {n} in the reply"))?;
+            let value = reply.field(n).ok_or_else(|| format!("no {n} in the reply"))?;
             say!("{n}: {value}");
         }
         None => say!("{}", reply_json(&reply)),
@@ -189,7 +95,10 @@ pub fn set(path: &str, name: &str, value: &str) -> Result<(), String> {
     let value = u16::try_from(value).map_err(|_| format!("{field}: {value} is out of range"))?;
     let mut driver = port::open_v1(path, None)?;
     let reply = readback(&mut driver, request)?;
-    let settings = with_field(&reply, field, value)?;
+    let settings = reply.with_field(field, value).map_err(|e| match e {
+        FieldError::OutOfRange => format!("{field}: {value} is out of range (0..=255, a bit field)"),
+        FieldError::NotHere => format!("{field}: the board's readback does not hold it"),
+    })?;
     driver
         .write_settings(settings)
         .map_err(|e| explain(&driver, e))?;

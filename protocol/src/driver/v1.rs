@@ -45,9 +45,10 @@
 use super::safety::{FrameKind, Safety, Wire};
 use super::sans_io::RxBuffer;
 use super::{Config, CoreError, Stamped, StreamInfo};
+pub use crate::v1::Settings;
 use crate::v1::{
-    BodyVelocity, COMMAND_LEN, Command, Downlink, DownlinkParser, Geometry, MotorVelocity, Pid,
-    Readback, Reply, Stats, SystemSettings, Telemetry,
+    BodyVelocity, COMMAND_LEN, Command, Downlink, DownlinkParser, MotorVelocity, Readback, Reply,
+    Stats, Telemetry,
 };
 
 /// The shortest failsafe on v1.0.0: six telemetry periods, so five frames dropped in a row
@@ -71,50 +72,6 @@ impl Wire for V1 {
 
     fn stop() -> Outgoing {
         Command::BodyVelocity(BodyVelocity::FORCED_STOP).encode()
-    }
-}
-
-/// A settings frame: what [`Request::Write`] writes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Settings {
-    /// `0x23`, read back by `0x33`.
-    System(SystemSettings),
-    /// `0x24`, read back by `0x34`.
-    Geometry(Geometry),
-    /// `0x40`, read back by `0x50`.
-    Pid(Pid),
-}
-
-impl Settings {
-    /// The frame.
-    #[must_use]
-    pub const fn command(&self) -> Command {
-        match *self {
-            Settings::System(s) => Command::System(s),
-            Settings::Geometry(g) => Command::Geometry(g),
-            Settings::Pid(p) => Command::Pid(p),
-        }
-    }
-
-    /// The readback that shows it.
-    #[must_use]
-    pub const fn readback(&self) -> Readback {
-        match self {
-            Settings::System(_) => Readback::System,
-            Settings::Geometry(_) => Readback::Geometry,
-            Settings::Pid(_) => Readback::Pid,
-        }
-    }
-
-    /// Whether `reply` carries these settings.
-    #[must_use]
-    pub fn shown_by(&self, reply: &Reply) -> bool {
-        match self {
-            Settings::System(s) => reply.system() == Some(*s),
-            Settings::Geometry(g) => reply.geometry() == Some(*g),
-            Settings::Pid(p) => reply.pid() == Some(*p),
-        }
     }
 }
 
@@ -609,6 +566,7 @@ impl super::Core for DriverCore {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::v1::{Geometry, Pid, SystemSettings};
 
     /// The forced stop, from PROTOCOL-V1.md: `0x25`, ten `00`, BCC `7B ^ 25 = 5E`.
     const FORCED_STOP: [u8; 14] = [0x7B, 0x25, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x5E, 0x7D];

@@ -27,8 +27,10 @@
 //! assert_eq!(read[12], 0x48);
 //! ```
 
+mod fields;
 mod parse;
 
+pub use fields::{FIELDS, FieldError, Settings, field_readback};
 pub use parse::{DownlinkParser, Frames, Parser, Stats, UplinkParser};
 
 use crate::wire;
