@@ -789,7 +789,7 @@ const fn request_name(request: v1::Readback) -> &'static str {
     }
 }
 
-/// `fields` as a JSON object, `"frame": kind` first.
+/// `fields` (a JSON object) with `"frame": kind`.
 fn object(kind: &str, fields: Value) -> Value {
     let mut map = Map::new();
     map.insert("frame".into(), json!(kind));

@@ -341,6 +341,71 @@ fn the_2020_golden_captures_are_still_2020() {
 }
 
 #[test]
+fn the_global_firmware_option_skips_detection() {
+    let v1 = golden("v1_downlink.hex");
+    for spelling in ["v1.0.0", "v1"] {
+        assert_decodes_to(
+            &[
+                "decode",
+                v1.as_str(),
+                "--input",
+                "hex",
+                "--firmware",
+                spelling,
+            ],
+            "v1_downlink.jsonl",
+            &["firmware v1.0.0 (given)", "8 frames (telemetry 3, reply 5)"],
+        );
+    }
+    let ff = golden("downlink.hex");
+    assert_decodes_to(
+        &[
+            "--firmware",
+            "2020",
+            "decode",
+            ff.as_str(),
+            "--input",
+            "hex",
+        ],
+        "downlink.jsonl",
+        &["firmware 2020 (given)", "0 bytes discarded"],
+    );
+    // Told the other generation: no frame, every byte discarded, said.
+    let out = chassis(&[
+        "decode",
+        v1.as_str(),
+        "--input",
+        "hex",
+        "--firmware",
+        "2020",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(out.stdout.is_empty());
+    assert!(
+        stderr(&out).contains("firmware 2020 (given); 166 bytes: imu 0, encoders 0, battery 0, reply 0; 166 bytes discarded"),
+        "{}",
+        stderr(&out)
+    );
+    let up = golden("uplink.hex");
+    let out = chassis(&[
+        "decode",
+        up.as_str(),
+        "--input",
+        "hex",
+        "--uplink",
+        "--firmware",
+        "v1",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(out.stdout.is_empty());
+    assert!(
+        stderr(&out).contains("firmware v1.0.0 (given); 94 bytes: 0 frames; 0 bad BCC"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
 fn a_capture_of_neither_generation_says_so_and_decodes_as_2020() {
     for (input, args, said) in [
         (&b""[..], &[][..], "no frames of either generation"),
