@@ -180,10 +180,12 @@ enum Cmd {
     },
     /// A live view of the telemetry; with --drive, keys drive the chassis.
     Monitor {
-        /// Drive with the keys (arrows / WASD, space stops, t turns 90° once).
+        /// Drive with the keys (arrows / WASD, space stops; 2020: t turns 90° once; v1.0.0:
+        /// z / x rotate at 0.5 rad/s).
         #[arg(long)]
         drive: bool,
-        /// The speed the keys drive at.
+        /// The speed the keys drive at: on the 2020 firmware in the board's raw units
+        /// (1..=65535), on v1.0.0 in mm/s (300 = 0.3 m/s; 1..=2000).
         #[arg(long, default_value = "300")]
         speed: String,
     },
@@ -580,7 +582,11 @@ fn run(cli: Cli) -> Result<(), String> {
                     let speed = value::parse_i32(&speed, "speed", 1, 65_535)?;
                     monitor::run(path, drive, speed)
                 }
-                Firmware::V1_0_0 => Err(not_on_v1("monitor", "not yet for v1.0.0")),
+                Firmware::V1_0_0 => {
+                    let speed = value::parse_i32(&speed, "speed", 1, 2_000)
+                        .map_err(|e| format!("{e}: on v1.0.0 the speed is in mm/s"))?;
+                    monitor::v1::run(path, drive, speed)
+                }
             }
         }
         // Run from `main`: its exit status is the verdict.

@@ -1,12 +1,18 @@
-//! `chassis monitor`: a live view of the board's telemetry; with `--drive`, keys drive it.
+//! `chassis monitor`: a live view of the board's telemetry; with `--drive`, keys drive it. On
+//! either firmware generation: this module holds what they share (the terminal, the keys, the
+//! failsafe's hold, the link and its stale marks: [`Monitor`] over a [`Chassis`]) and the 2020
+//! board's screen; [`v1`] holds the v1.0.0 board's.
 //!
-//! The screen is drawn from a [`View`] (a plain value taken from the driver each frame), so a
-//! test renders it with ratatui's test backend. Keys: arrows or WASD drive at the set speed,
-//! space stops, `t` turns 90° once (the pending angle is read until it is done), `+`/`-` change
-//! the speed at once, `q`, Esc or Ctrl-C quit (stopping first); SIGINT, SIGTERM and SIGHUP
-//! stop the chassis too. The driver's failsafe stays active: a board that goes quiet is
-//! stopped, and stays stopped until the link is back and a key is pressed again; the figures
-//! of a board gone quiet are marked stale.
+//! The screen is drawn from a view (a plain value taken from the driver each frame, [`View`] on
+//! the 2020 board), so a test renders it with ratatui's test backend. Keys: arrows or WASD
+//! drive at the set speed, space stops, `t` turns 90° once on the 2020 board (the pending angle
+//! is read until it is done; v1.0.0 has no turn by an angle: `z` / `x` rotate at a fixed rate
+//! there), `+`/`-` change the speed at once, `q`, Esc or Ctrl-C quit (stopping first); SIGINT,
+//! SIGTERM and SIGHUP stop the chassis too. The driver's failsafe stays active: a board that
+//! goes quiet is stopped, and stays stopped until the link is back and a key is pressed again;
+//! the figures of a board gone quiet are marked stale.
+
+pub mod v1;
 
 use crate::device::{explain, open};
 use crate::port::Board;
@@ -22,8 +28,434 @@ use ratatui::widgets::{Block, Borders, Gauge, Paragraph, Row, Sparkline, Table, 
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
+// ----- shared by both generations -----
+
+/// What the monitor needs of a board, whichever its firmware: the driver's pump, its motion
+/// frames, its failsafe count, and the generation's screen. Velocities are `[x, y, z]`: x
+/// sideways (right positive), y forward, z the rotation, in the generation's own units.
+pub trait Chassis {
+    /// What the generation's screen shows, taken each frame.
+    type View;
+
+    /// The port's path.
+    fn port(&self) -> &str;
+
+    /// Takes in what the port holds, without blocking: `Ok(true)` when a frame of any kind
+    /// came, `Ok(false)` when nothing waits. The driver judges its failsafe here.
+    fn poll(&mut self) -> Result<bool, String>;
+
+    /// Times the driver's failsafe has stopped the chassis.
+    fn failsafe_stops(&self) -> u32;
+
+    /// Sends `velocity` (re-sent every 50 ms while it is not zero).
+    fn drive(&mut self, velocity: [i32; 3]) -> Result<(), String>;
+
+    /// Sends the generation's stop (on the 2020 board a turn is cancelled too).
+    fn stop(&mut self) -> Result<(), String>;
+
+    /// The rate the rotate keys (`z`, `x`) turn at, in the generation's z unit; or why there
+    /// are none.
+    fn rotate_rate(&self) -> Result<i32, &'static str>;
+
+    /// `t`, a turn by 90° sent once, with the link `alive` or not: `Ok(message)` when it was
+    /// sent (the chassis moves: the failsafe's hold ends), `Err(message)` when nothing was.
+    fn turn(&mut self, alive: bool) -> Result<String, String>;
+
+    /// What follows the poll each tick (the 2020 board reads a turn's pending angle): a
+    /// message to show, if any.
+    fn follow_up(&mut self) -> Option<String>;
+
+    /// The screen's contents now, `status` being the monitor's part.
+    fn view(&self, status: Status) -> Self::View;
+
+    /// Draws the whole screen.
+    fn render(frame: &mut Frame<'_>, view: &Self::View);
+}
+
+/// The monitor's own part of the screen, the same on both generations.
+#[derive(Clone, Debug, Default)]
+pub struct Status {
+    /// The port.
+    pub port: String,
+    /// Whether a frame came lately.
+    pub link_alive: bool,
+    /// With the link down: how long ago the last frame came, in ms (the figures are that old).
+    pub stale_ms: Option<u64>,
+    /// Driving from the keyboard.
+    pub driving: bool,
+    /// The failsafe stopped the chassis: nothing moves until a key is pressed.
+    pub held: bool,
+    /// The speed keys drive at.
+    pub speed: i32,
+    /// The velocity being sent: x, y, z.
+    pub velocity: [i32; 3],
+    /// The last message (errors, refusals).
+    pub message: String,
+}
+
+/// The top line: the name, the port, LINK UP / NO LINK, STALE, then `tail`.
+fn title_bar(
+    frame: &mut Frame<'_>,
+    area: Rect,
+    port: &str,
+    alive: bool,
+    stale_ms: Option<u64>,
+    tail: String,
+) {
+    let link = if alive {
+        Span::styled(" LINK UP ", Style::new().fg(Color::Black).bg(Color::Green))
+    } else {
+        Span::styled(" NO LINK ", Style::new().fg(Color::White).bg(Color::Red))
+    };
+    frame.render_widget(
+        Paragraph::new(Line::from(vec![
+            Span::styled(
+                " chassis monitor ",
+                Style::new().add_modifier(Modifier::BOLD),
+            ),
+            Span::raw(format!("{port}  ")),
+            link,
+            Span::raw(match stale_ms {
+                Some(ms) => format!("  STALE {:.1} s", ms as f64 / 1000.0),
+                None => String::new(),
+            }),
+            Span::raw(tail),
+        ])),
+        area,
+    );
+}
+
+/// A stream's rate, or "stale" while the link is down (no rate shown as if live).
+fn rate_text(rate_millihertz: u32, stale_ms: Option<u64>) -> String {
+    if stale_ms.is_some() {
+        "stale".to_string()
+    } else {
+        format!("{:.1} Hz", f64::from(rate_millihertz) / 1000.0)
+    }
+}
+
+/// The drive panel: the hold, what is being sent (`driving_line`), or read only; the message.
+fn drive_panel(
+    frame: &mut Frame<'_>,
+    area: Rect,
+    driving: bool,
+    held: bool,
+    driving_line: String,
+    message: &str,
+) {
+    let first = if driving && held {
+        "stopped by the failsafe: press a key to drive again (once LINK UP)".to_string()
+    } else if driving {
+        driving_line
+    } else {
+        "read only (start with --drive to drive)".to_string()
+    };
+    frame.render_widget(
+        Paragraph::new(vec![Line::from(first), Line::from(message.to_string())])
+            .wrap(Wrap { trim: true })
+            .block(Block::bordered().title(" drive ")),
+        area,
+    );
+}
+
+/// The keys line at the bottom.
+fn keys_bar(frame: &mut Frame<'_>, area: Rect, driving: bool, driving_keys: &str) {
+    frame.render_widget(
+        Paragraph::new(if driving { driving_keys } else { "q quit" })
+            .block(Block::new().borders(Borders::TOP)),
+        area,
+    );
+}
+
+/// What a key asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Key {
+    /// Drive forward (up, `w`).
+    Forward,
+    /// Drive backward (down, `s`).
+    Backward,
+    /// Drive left (left, `a`).
+    Left,
+    /// Drive right (right, `d`).
+    Right,
+    /// Rotate counter-clockwise at a fixed rate (`z`; v1.0.0 only).
+    RotateLeft,
+    /// Rotate clockwise at a fixed rate (`x`; v1.0.0 only).
+    RotateRight,
+    /// Stop (space).
+    Stop,
+    /// Turn 90° once (`t`; the 2020 firmware only).
+    Turn,
+    /// Faster (`+`).
+    Faster,
+    /// Slower (`-`).
+    Slower,
+    /// Quit, stopping first (`q`, Esc, Ctrl-C).
+    Quit,
+}
+
+impl Key {
+    /// The key a terminal event is, if any.
+    pub fn of(event: &Event) -> Option<Key> {
+        let Event::Key(key) = event else {
+            return None;
+        };
+        if key.kind != KeyEventKind::Press {
+            return None;
+        }
+        Some(match key.code {
+            // Raw mode: Ctrl-C is a key, not a signal.
+            KeyCode::Char('c') if key.modifiers.contains(KeyModifiers::CONTROL) => Key::Quit,
+            KeyCode::Char('q') | KeyCode::Esc => Key::Quit,
+            KeyCode::Up | KeyCode::Char('w') => Key::Forward,
+            KeyCode::Down | KeyCode::Char('s') => Key::Backward,
+            KeyCode::Left | KeyCode::Char('a') => Key::Left,
+            KeyCode::Right | KeyCode::Char('d') => Key::Right,
+            KeyCode::Char('z') => Key::RotateLeft,
+            KeyCode::Char('x') => Key::RotateRight,
+            KeyCode::Char(' ') => Key::Stop,
+            KeyCode::Char('t') => Key::Turn,
+            KeyCode::Char('+' | '=') => Key::Faster,
+            KeyCode::Char('-' | '_') => Key::Slower,
+            _ => return None,
+        })
+    }
+}
+
+/// The monitor's logic, apart from the terminal and from the generation: what the keys did,
+/// the failsafe's hold, the link. [`run_monitor`] feeds it the terminal's keys; a test feeds
+/// it keys of its own.
+pub struct Monitor<C> {
+    chassis: C,
+    drive: bool,
+    speed: i32,
+    velocity: [i32; 3],
+    /// The failsafe stopped the chassis: nothing moves until the link is back and a key is
+    /// pressed.
+    held: bool,
+    failsafe_seen: u32,
+    last_frame: Option<Instant>,
+    message: String,
+    next_send: Instant,
+}
+
+impl<C: Chassis> Monitor<C> {
+    /// A monitor over `chassis`; `drive`: keys drive at `speed`.
+    pub fn new(chassis: C, drive: bool, speed: i32) -> Self {
+        Monitor {
+            chassis,
+            drive,
+            speed,
+            velocity: [0; 3],
+            held: false,
+            failsafe_seen: 0,
+            last_frame: None,
+            message: String::new(),
+            next_send: Instant::now(),
+        }
+    }
+
+    /// Whether a frame came in the last half second.
+    pub fn link_alive(&self) -> bool {
+        self.last_frame
+            .is_some_and(|t| t.elapsed() < Duration::from_millis(500))
+    }
+
+    /// Takes in what the port holds for `ms`, judges the failsafe, re-sends the velocity, lets
+    /// the generation follow up (a turn's pending angle). Never ends on a board error: it is
+    /// shown.
+    pub fn tick(&mut self, ms: u64) {
+        let until = Instant::now() + Duration::from_millis(ms);
+        while Instant::now() < until {
+            match self.chassis.poll() {
+                Ok(true) => self.last_frame = Some(Instant::now()),
+                Ok(false) => std::thread::sleep(Duration::from_millis(1)),
+                Err(e) => self.message = e,
+            }
+        }
+        let stops = self.chassis.failsafe_stops();
+        if stops != self.failsafe_seen {
+            self.failsafe_seen = stops;
+            if self.drive {
+                // The driver stopped the chassis: never drive it again on our own.
+                self.velocity = [0; 3];
+                self.held = true;
+                self.message = "the board went quiet: the failsafe stopped the chassis; once the link is back, press a key to drive".into();
+            }
+        }
+        if self.drive && Instant::now() >= self.next_send {
+            self.next_send = Instant::now() + Duration::from_millis(50);
+            if self.velocity != [0; 3] && !self.held {
+                if let Err(e) = self.chassis.drive(self.velocity) {
+                    self.message = e;
+                }
+            }
+        }
+        if let Some(message) = self.chassis.follow_up() {
+            self.message = message;
+        }
+    }
+
+    /// Does what `key` asks; `false` once it asks to quit.
+    pub fn key(&mut self, key: Key) -> bool {
+        let s = self.speed;
+        let target = match key {
+            Key::Quit => return false,
+            _ if !self.drive => return true,
+            Key::Forward => [0, s, 0],
+            Key::Backward => [0, -s, 0],
+            Key::Left => [-s, 0, 0],
+            Key::Right => [s, 0, 0],
+            Key::RotateLeft | Key::RotateRight => match self.chassis.rotate_rate() {
+                Ok(rate) if key == Key::RotateLeft => [0, 0, rate],
+                Ok(rate) => [0, 0, -rate],
+                Err(why) => {
+                    self.message = why.into();
+                    return true;
+                }
+            },
+            Key::Stop => {
+                self.velocity = [0; 3];
+                self.message = match self.chassis.stop() {
+                    Ok(()) => "stopped".into(),
+                    Err(e) => e,
+                };
+                return true;
+            }
+            Key::Faster | Key::Slower => {
+                self.speed = if key == Key::Faster {
+                    (s + 50).min(2_000)
+                } else {
+                    (s - 50).max(50)
+                };
+                // The new speed applies at once, in the direction being driven (a rotation
+                // keeps its fixed rate).
+                let [x, y, z] = self.velocity;
+                self.velocity = [x.signum() * self.speed, y.signum() * self.speed, z];
+                self.next_send = Instant::now();
+                return true;
+            }
+            Key::Turn => {
+                match self.chassis.turn(self.link_alive()) {
+                    Ok(message) => {
+                        self.held = false;
+                        self.message = message;
+                    }
+                    Err(message) => self.message = message,
+                }
+                return true;
+            }
+        };
+        if !self.link_alive() {
+            self.message = "no link: not driving (the board is not heard)".into();
+            return true;
+        }
+        self.held = false;
+        self.velocity = target;
+        self.next_send = Instant::now();
+        self.message.clear();
+        true
+    }
+
+    /// What the screen shows now.
+    pub fn view(&self) -> C::View {
+        let alive = self.link_alive();
+        self.chassis.view(Status {
+            port: self.chassis.port().to_string(),
+            link_alive: alive,
+            stale_ms: if alive {
+                None
+            } else {
+                self.last_frame
+                    .map(|t| u64::try_from(t.elapsed().as_millis()).unwrap_or(u64::MAX))
+            },
+            driving: self.drive,
+            held: self.held,
+            speed: self.speed,
+            velocity: self.velocity,
+            message: self.message.clone(),
+        })
+    }
+
+    /// Stops the chassis (cancelling a turn) if this monitor drives it.
+    pub fn stop(&mut self) -> Result<(), String> {
+        if !self.drive {
+            return Ok(());
+        }
+        self.velocity = [0; 3];
+        self.chassis.stop()
+    }
+}
+
+/// `chassis monitor [--drive]` over the board `open` opens (once the terminal is known to be
+/// one, and the signals are caught): draws until a quit key or a signal, then stops the
+/// chassis before giving the terminal back.
+pub fn run_monitor<C: Chassis>(
+    open: impl FnOnce() -> Result<C, String>,
+    drive: bool,
+    speed: i32,
+) -> Result<(), String> {
+    use std::io::IsTerminal;
+    if !std::io::stdin().is_terminal() || !std::io::stdout().is_terminal() {
+        return Err(
+            "monitor draws on a terminal and reads its keys: run it in one (stdin and stdout a terminal, not a pipe or a file); `chassis record` captures without one".into(),
+        );
+    }
+    signals::install()?;
+    let mut monitor = Monitor::new(open()?, drive, speed);
+    let mut terminal = ratatui::try_init().map_err(|e| format!("terminal: {e}"))?;
+    let result = monitor_loop(&mut terminal, &mut monitor);
+    // Stop before giving the terminal back, whatever happened.
+    let stopped = monitor.stop();
+    ratatui::restore();
+    if let Some(signal) = signals::caught() {
+        return Err(format!(
+            "interrupted by {}{}",
+            signals::name(signal),
+            match (drive, stopped) {
+                (false, _) => String::new(),
+                (true, Ok(())) => ": the chassis was stopped".into(),
+                (true, Err(e)) => format!(": the stop was sent but not confirmed: {e}"),
+            }
+        ));
+    }
+    result?;
+    stopped
+}
+
+fn monitor_loop<C: Chassis>(
+    terminal: &mut ratatui::DefaultTerminal,
+    monitor: &mut Monitor<C>,
+) -> Result<(), String> {
+    let mut next_draw = Instant::now();
+    while signals::caught().is_none() {
+        monitor.tick(20);
+        while event::poll(Duration::ZERO).map_err(|e| format!("terminal: {e}"))? {
+            let event = event::read().map_err(|e| format!("terminal: {e}"))?;
+            if let Some(key) = Key::of(&event) {
+                if !monitor.key(key) {
+                    return Ok(());
+                }
+            }
+        }
+        if Instant::now() >= next_draw {
+            next_draw = Instant::now() + Duration::from_millis(100);
+            let view = monitor.view();
+            terminal
+                .draw(|f| C::render(f, &view))
+                .map_err(|e| format!("terminal: {e}"))?;
+        }
+    }
+    Ok(())
+}
+
+// ----- the 2020 board -----
+
 /// Gyro Z readings kept for the sparkline.
 const HISTORY: usize = 120;
+
+/// How often the pending angle is read while a turn is outstanding.
+const TURN_READ: Duration = Duration::from_millis(250);
 
 /// What one stream looks like.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -36,7 +468,7 @@ pub struct StreamView {
     pub missed: u32,
 }
 
-/// Everything the screen shows.
+/// Everything the 2020 board's screen shows.
 #[derive(Clone, Debug, Default)]
 pub struct View {
     /// The port.
@@ -75,7 +507,7 @@ pub struct View {
     pub message: String,
 }
 
-/// Draws the whole screen.
+/// Draws the 2020 board's whole screen.
 pub fn render(frame: &mut Frame<'_>, view: &View) {
     let [title, body, keys] = Layout::vertical([
         Constraint::Length(1),
@@ -83,34 +515,21 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
         Constraint::Length(3),
     ])
     .areas(frame.area());
-    let link = if view.link_alive {
-        Span::styled(" LINK UP ", Style::new().fg(Color::Black).bg(Color::Green))
-    } else {
-        Span::styled(" NO LINK ", Style::new().fg(Color::White).bg(Color::Red))
-    };
     let lock = match view.lock {
         Some(Lock::Locked) => "locked",
         Some(Lock::Tentative) => "tentative",
         Some(Lock::Hunting) | None => "hunting",
     };
-    frame.render_widget(
-        Paragraph::new(Line::from(vec![
-            Span::styled(
-                " chassis monitor ",
-                Style::new().add_modifier(Modifier::BOLD),
-            ),
-            Span::raw(format!("{}  ", view.port)),
-            link,
-            Span::raw(match view.stale_ms {
-                Some(ms) => format!("  STALE {:.1} s", ms as f64 / 1000.0),
-                None => String::new(),
-            }),
-            Span::raw(format!(
-                "  failsafe stops {}  parser {lock}, {} bytes discarded",
-                view.failsafe_stops, view.discarded
-            )),
-        ])),
+    title_bar(
+        frame,
         title,
+        &view.port,
+        view.link_alive,
+        view.stale_ms,
+        format!(
+            "  failsafe stops {}  parser {lock}, {} bytes discarded",
+            view.failsafe_stops, view.discarded
+        ),
     );
     let [left, right] =
         Layout::horizontal([Constraint::Percentage(55), Constraint::Percentage(45)]).areas(body);
@@ -190,11 +609,7 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
         .map(|(name, s)| {
             Row::new(vec![
                 (*name).to_string(),
-                if view.stale_ms.is_some() {
-                    "stale".to_string()
-                } else {
-                    format!("{:.1} Hz", f64::from(s.rate_millihertz) / 1000.0)
-                },
+                rate_text(s.rate_millihertz, view.stale_ms),
                 s.frames.to_string(),
                 s.missed.to_string(),
             ])
@@ -216,43 +631,26 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
         .block(Block::bordered().title(" streams ")),
         streams_area,
     );
-    let drive = if view.driving && view.held {
-        vec![
-            Line::from("stopped by the failsafe: press a key to drive again (once LINK UP)"),
-            Line::from(view.message.clone()),
-        ]
-    } else if view.driving {
-        vec![
-            Line::from(format!(
-                "driving at {}: x {} y {} z {}{}",
-                view.speed,
-                view.velocity[0],
-                view.velocity[1],
-                view.velocity[2],
-                if view.turning { "  (turning)" } else { "" }
-            )),
-            Line::from(view.message.clone()),
-        ]
-    } else {
-        vec![
-            Line::from("read only (start with --drive to drive)"),
-            Line::from(view.message.clone()),
-        ]
-    };
-    frame.render_widget(
-        Paragraph::new(drive)
-            .wrap(Wrap { trim: true })
-            .block(Block::bordered().title(" drive ")),
+    drive_panel(
+        frame,
         drive_area,
+        view.driving,
+        view.held,
+        format!(
+            "driving at {}: x {} y {} z {}{}",
+            view.speed,
+            view.velocity[0],
+            view.velocity[1],
+            view.velocity[2],
+            if view.turning { "  (turning)" } else { "" }
+        ),
+        &view.message,
     );
-    let help = if view.driving {
-        "arrows/WASD drive  space stop  t turn 90° once  +/- speed  q or Ctrl-C quit"
-    } else {
-        "q quit"
-    };
-    frame.render_widget(
-        Paragraph::new(help).block(Block::new().borders(Borders::TOP)),
+    keys_bar(
+        frame,
         keys,
+        view.driving,
+        "arrows/WASD drive  space stop  t turn 90° once  +/- speed  q or Ctrl-C quit",
     );
 }
 
@@ -276,213 +674,94 @@ fn render_imu(frame: &mut Frame<'_>, area: Rect, view: &View) {
     );
 }
 
-/// What a key asks for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Key {
-    /// Drive forward (up, `w`).
-    Forward,
-    /// Drive backward (down, `s`).
-    Backward,
-    /// Drive left (left, `a`).
-    Left,
-    /// Drive right (right, `d`).
-    Right,
-    /// Stop (space).
-    Stop,
-    /// Turn 90° once (`t`).
-    Turn,
-    /// Faster (`+`).
-    Faster,
-    /// Slower (`-`).
-    Slower,
-    /// Quit, stopping first (`q`, Esc, Ctrl-C).
-    Quit,
-}
-
-impl Key {
-    /// The key a terminal event is, if any.
-    pub fn of(event: &Event) -> Option<Key> {
-        let Event::Key(key) = event else {
-            return None;
-        };
-        if key.kind != KeyEventKind::Press {
-            return None;
-        }
-        Some(match key.code {
-            // Raw mode: Ctrl-C is a key, not a signal.
-            KeyCode::Char('c') if key.modifiers.contains(KeyModifiers::CONTROL) => Key::Quit,
-            KeyCode::Char('q') | KeyCode::Esc => Key::Quit,
-            KeyCode::Up | KeyCode::Char('w') => Key::Forward,
-            KeyCode::Down | KeyCode::Char('s') => Key::Backward,
-            KeyCode::Left | KeyCode::Char('a') => Key::Left,
-            KeyCode::Right | KeyCode::Char('d') => Key::Right,
-            KeyCode::Char(' ') => Key::Stop,
-            KeyCode::Char('t') => Key::Turn,
-            KeyCode::Char('+' | '=') => Key::Faster,
-            KeyCode::Char('-' | '_') => Key::Slower,
-            _ => return None,
-        })
-    }
-}
-
-/// How often the pending angle is read while a turn is outstanding.
-const TURN_READ: Duration = Duration::from_millis(250);
-
-/// The monitor's logic, apart from the terminal: what the keys did, the failsafe's hold, the
-/// link. [`run`] feeds it the terminal's keys; a test feeds it keys of its own.
-pub struct Monitor {
+/// The 2020 board under the monitor: its driver, the gyro Z history, the next read of a
+/// turn's pending angle.
+pub struct Board2020 {
     driver: Board,
-    drive: bool,
-    speed: i32,
-    velocity: Velocity,
-    /// The failsafe stopped the chassis: nothing moves until the link is back and a key is
-    /// pressed.
-    held: bool,
-    failsafe_seen: u32,
-    last_frame: Option<Instant>,
     history: VecDeque<i16>,
-    message: String,
-    next_send: Instant,
     next_turn_read: Instant,
 }
 
-impl Monitor {
-    /// A monitor over `driver`; `drive`: keys drive at `speed`.
-    pub fn new(driver: Board, drive: bool, speed: i32) -> Self {
-        Monitor {
+impl Board2020 {
+    /// The board behind `driver`.
+    pub fn new(driver: Board) -> Self {
+        Board2020 {
             driver,
-            drive,
-            speed,
-            velocity: Velocity::new(0, 0, 0),
-            held: false,
-            failsafe_seen: 0,
-            last_frame: None,
             history: VecDeque::with_capacity(HISTORY),
-            message: String::new(),
-            next_send: Instant::now(),
             next_turn_read: Instant::now(),
         }
     }
+}
 
-    /// Whether a frame came in the last half second.
-    pub fn link_alive(&self) -> bool {
-        self.last_frame
-            .is_some_and(|t| t.elapsed() < Duration::from_millis(500))
+impl Chassis for Board2020 {
+    type View = View;
+
+    fn port(&self) -> &str {
+        self.driver.uart().name()
     }
 
-    /// Takes in what the port holds for `ms`, judges the failsafe, re-sends the velocity, reads
-    /// the pending angle of a turn. Never ends on a board error: it is shown.
-    pub fn tick(&mut self, ms: u64) {
-        let until = Instant::now() + Duration::from_millis(ms);
-        while Instant::now() < until {
-            match self.driver.poll() {
-                Ok(Some(DriverEvent::Telemetry(Downlink::Imu(imu)))) => {
-                    self.last_frame = Some(Instant::now());
-                    if self.history.len() == HISTORY {
-                        self.history.pop_front();
-                    }
-                    self.history.push_back(imu.gyro[2]);
+    fn poll(&mut self) -> Result<bool, String> {
+        match self.driver.poll() {
+            Ok(Some(DriverEvent::Telemetry(Downlink::Imu(imu)))) => {
+                if self.history.len() == HISTORY {
+                    self.history.pop_front();
                 }
-                Ok(Some(_)) => self.last_frame = Some(Instant::now()),
-                Ok(None) => std::thread::sleep(Duration::from_millis(1)),
-                Err(e) => self.message = explain(&self.driver, e),
+                self.history.push_back(imu.gyro[2]);
+                Ok(true)
             }
+            Ok(Some(_)) => Ok(true),
+            Ok(None) => Ok(false),
+            Err(e) => Err(explain(&self.driver, e)),
         }
-        let stops = self.driver.core().failsafe_stops();
-        if stops != self.failsafe_seen {
-            self.failsafe_seen = stops;
-            if self.drive {
-                // The driver stopped the chassis: never drive it again on our own.
-                self.velocity = Velocity::new(0, 0, 0);
-                self.held = true;
-                self.message = "the board went quiet: the failsafe stopped the chassis; once the link is back, press a key to drive".into();
+    }
+
+    fn failsafe_stops(&self) -> u32 {
+        self.driver.core().failsafe_stops()
+    }
+
+    fn drive(&mut self, [x, y, z]: [i32; 3]) -> Result<(), String> {
+        self.driver
+            .set_velocity(Velocity::new(x, y, z))
+            .map_err(|e| explain(&self.driver, e))
+    }
+
+    fn stop(&mut self) -> Result<(), String> {
+        self.driver.stop().map_err(|e| explain(&self.driver, e))
+    }
+
+    fn rotate_rate(&self) -> Result<i32, &'static str> {
+        Err("no rotate keys on the 2020 firmware: t turns 90°")
+    }
+
+    fn turn(&mut self, alive: bool) -> Result<String, String> {
+        if !alive {
+            return Err("no link: not turning".into());
+        }
+        match self.driver.turn_by(900) {
+            Ok(()) => {
+                self.next_turn_read = Instant::now() + TURN_READ;
+                Ok("turning 90° (sent once)".into())
             }
-        }
-        if self.drive && Instant::now() >= self.next_send {
-            self.next_send = Instant::now() + Duration::from_millis(50);
-            if self.velocity != Velocity::new(0, 0, 0) && !self.held {
-                if let Err(e) = self.driver.set_velocity(self.velocity) {
-                    self.message = explain(&self.driver, e);
-                }
+            Err(Error::Core(CoreError::TurnInProgress)) => {
+                Err("a turn is still going: not sent again".into())
             }
+            Err(e) => Err(explain(&self.driver, e)),
         }
+    }
+
+    fn follow_up(&mut self) -> Option<String> {
         if self.driver.core().turning() && Instant::now() >= self.next_turn_read {
             self.next_turn_read = Instant::now() + TURN_READ;
             // A read lost is tried again at the next one.
             if self.driver.turn_remaining().is_ok() && !self.driver.core().turning() {
-                self.message = "turn done".into();
+                return Some("turn done".into());
             }
         }
+        None
     }
 
-    /// Does what `key` asks; `false` once it asks to quit.
-    pub fn key(&mut self, key: Key) -> bool {
-        let s = self.speed;
-        let target = match key {
-            Key::Quit => return false,
-            _ if !self.drive => return true,
-            Key::Forward => Velocity::new(0, s, 0),
-            Key::Backward => Velocity::new(0, -s, 0),
-            Key::Left => Velocity::new(-s, 0, 0),
-            Key::Right => Velocity::new(s, 0, 0),
-            Key::Stop => {
-                self.velocity = Velocity::new(0, 0, 0);
-                self.message = match self.driver.stop() {
-                    Ok(()) => "stopped".into(),
-                    Err(e) => explain(&self.driver, e),
-                };
-                return true;
-            }
-            Key::Faster | Key::Slower => {
-                self.speed = if key == Key::Faster {
-                    (s + 50).min(2_000)
-                } else {
-                    (s - 50).max(50)
-                };
-                // The new speed applies at once, in the direction being driven.
-                let v = self.velocity;
-                self.velocity = Velocity::new(
-                    v.x.signum() * self.speed,
-                    v.y.signum() * self.speed,
-                    v.z.signum() * self.speed,
-                );
-                self.next_send = Instant::now();
-                return true;
-            }
-            Key::Turn => {
-                if !self.link_alive() {
-                    self.message = "no link: not turning".into();
-                    return true;
-                }
-                self.message = match self.driver.turn_by(900) {
-                    Ok(()) => {
-                        self.held = false;
-                        self.next_turn_read = Instant::now() + TURN_READ;
-                        "turning 90° (sent once)".into()
-                    }
-                    Err(Error::Core(CoreError::TurnInProgress)) => {
-                        "a turn is still going: not sent again".into()
-                    }
-                    Err(e) => explain(&self.driver, e),
-                };
-                return true;
-            }
-        };
-        if !self.link_alive() {
-            self.message = "no link: not driving (the board is not heard)".into();
-            return true;
-        }
-        self.held = false;
-        self.velocity = target;
-        self.next_send = Instant::now();
-        self.message.clear();
-        true
-    }
-
-    /// What the screen shows now.
-    pub fn view(&self) -> View {
+    fn view(&self, status: Status) -> View {
         let core = self.driver.core();
-        let alive = self.link_alive();
         let mut streams = [StreamView::default(); 3];
         for s in Stream::ALL {
             let info = core.stream(s);
@@ -495,14 +774,9 @@ impl Monitor {
             }
         }
         View {
-            port: self.driver.uart().name().to_string(),
-            link_alive: alive,
-            stale_ms: if alive {
-                None
-            } else {
-                self.last_frame
-                    .map(|t| u64::try_from(t.elapsed().as_millis()).unwrap_or(u64::MAX))
-            },
+            port: status.port,
+            link_alive: status.link_alive,
+            stale_ms: status.stale_ms,
             lock: Some(core.lock()),
             imu: core.imu().map(|s| s.value),
             encoders: core.encoders().map(|s| s.value),
@@ -515,79 +789,23 @@ impl Monitor {
                 .iter()
                 .map(|g| u64::from(g.unsigned_abs()))
                 .collect(),
-            driving: self.drive,
-            held: self.held,
-            speed: self.speed,
-            velocity: [self.velocity.x, self.velocity.y, self.velocity.z],
+            driving: status.driving,
+            held: status.held,
+            speed: status.speed,
+            velocity: status.velocity,
             turning: core.turning(),
-            message: self.message.clone(),
+            message: status.message,
         }
     }
 
-    /// Stops the chassis (cancelling a turn) if this monitor drives it.
-    pub fn stop(&mut self) -> Result<(), String> {
-        if !self.drive {
-            return Ok(());
-        }
-        self.velocity = Velocity::new(0, 0, 0);
-        self.driver.stop().map_err(|e| explain(&self.driver, e))
+    fn render(frame: &mut Frame<'_>, view: &View) {
+        render(frame, view);
     }
 }
 
-/// `chassis monitor [--drive]`.
+/// `chassis monitor [--drive]` on a 2020 board.
 pub fn run(port: &str, drive: bool, speed: i32) -> Result<(), String> {
-    use std::io::IsTerminal;
-    if !std::io::stdin().is_terminal() || !std::io::stdout().is_terminal() {
-        return Err(
-            "monitor draws on a terminal and reads its keys: run it in one (stdin and stdout a terminal, not a pipe or a file); `chassis record` captures without one".into(),
-        );
-    }
-    signals::install()?;
-    let mut monitor = Monitor::new(open(port)?, drive, speed);
-    let mut terminal = ratatui::try_init().map_err(|e| format!("terminal: {e}"))?;
-    let result = monitor_loop(&mut terminal, &mut monitor);
-    // Stop before giving the terminal back, whatever happened.
-    let stopped = monitor.stop();
-    ratatui::restore();
-    if let Some(signal) = signals::caught() {
-        return Err(format!(
-            "interrupted by {}{}",
-            signals::name(signal),
-            match (drive, stopped) {
-                (false, _) => String::new(),
-                (true, Ok(())) => ": the chassis was stopped".into(),
-                (true, Err(e)) => format!(": the stop was sent but not confirmed: {e}"),
-            }
-        ));
-    }
-    result?;
-    stopped
-}
-
-fn monitor_loop(
-    terminal: &mut ratatui::DefaultTerminal,
-    monitor: &mut Monitor,
-) -> Result<(), String> {
-    let mut next_draw = Instant::now();
-    while signals::caught().is_none() {
-        monitor.tick(20);
-        while event::poll(Duration::ZERO).map_err(|e| format!("terminal: {e}"))? {
-            let event = event::read().map_err(|e| format!("terminal: {e}"))?;
-            if let Some(key) = Key::of(&event) {
-                if !monitor.key(key) {
-                    return Ok(());
-                }
-            }
-        }
-        if Instant::now() >= next_draw {
-            next_draw = Instant::now() + Duration::from_millis(100);
-            let view = monitor.view();
-            terminal
-                .draw(|f| render(f, &view))
-                .map_err(|e| format!("terminal: {e}"))?;
-        }
-    }
-    Ok(())
+    run_monitor(|| open(port).map(Board2020::new), drive, speed)
 }
 
 #[cfg(test)]

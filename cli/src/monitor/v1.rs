@@ -1,0 +1,446 @@
+//! `chassis monitor` on a board running the v1.0.0 firmware (`7B … BCC 7D`): its screen and
+//! its [`Chassis`]. The keys, the failsafe's hold, the link and the terminal are the 2020
+//! board's ([`super::Monitor`]); what differs is what the board says and how it is driven:
+//!
+//! * one telemetry frame at about 22 Hz: the measured body velocity (mm/s and mrad/s, shown in
+//!   m/s and rad/s), the yaw worked out from the quaternion, the gyro and accelerometer raw
+//!   (their scale is unknown), the battery (mV, shown in V);
+//! * the link counters of the `7B … 7D` parser: frames good, bad BCC, bytes discarded, and the
+//!   failsafe's stops;
+//! * the keys drive at `--speed` mm/s, `z` / `x` rotate at [`ROTATE_MRAD_S`], space sends the
+//!   forced stop; there is no turn by an angle (`t` only says so).
+
+use super::{Chassis, Status, drive_panel, keys_bar, rate_text, title_bar};
+use crate::port::BoardV1;
+use chassis_protocol::driver::Error;
+use chassis_protocol::driver::host::SerialError;
+use chassis_protocol::v1::{BodyVelocity, Telemetry};
+use ratatui::Frame;
+use ratatui::layout::{Constraint, Layout};
+use ratatui::style::{Color, Style};
+use ratatui::text::Line;
+use ratatui::widgets::{Block, Paragraph};
+
+/// The rate the rotate keys turn at: 0.5 rad/s.
+pub const ROTATE_MRAD_S: i32 = 500;
+
+/// What `t` says on v1.0.0: nothing is sent.
+pub const NO_TURN: &str = "no turn by an angle on v1.0.0 (nothing sent): z / x rotate at 0.5 rad/s";
+
+/// The yaw in degrees, in (-180, 180], of the quaternion w, x, y, z (× 1000, as the telemetry
+/// carries it): atan2(2(wz + xy), 1 − 2(y² + z²)). The second term is written
+/// w² + x² − y² − z², the same for a unit quaternion and right for one the rounding to
+/// thousandths left a little off unit length. `None` for the zero quaternion (no rotation
+/// known).
+pub fn yaw_degrees(quaternion: [i16; 4]) -> Option<f64> {
+    let [w, x, y, z] = quaternion.map(|q| f64::from(q) / 1000.0);
+    let norm = w * w + x * x + y * y + z * z;
+    if norm == 0.0 {
+        return None;
+    }
+    let yaw = (2.0 * (w * z + x * y))
+        .atan2(norm - 2.0 * (y * y + z * z))
+        .to_degrees();
+    // atan2 gives [-180, 180]: -180 is the same heading as 180.
+    Some(if yaw <= -180.0 { yaw + 360.0 } else { yaw })
+}
+
+/// Thousandths (mm/s, mrad/s, mV) as units, three decimals.
+fn units(milli: i32) -> String {
+    format!("{:.3}", f64::from(milli) / 1000.0)
+}
+
+/// Everything the v1.0.0 board's screen shows.
+#[derive(Clone, Debug, Default)]
+pub struct View {
+    /// The monitor's part: port, link, hold, what is sent, the message.
+    pub status: Status,
+    /// The latest telemetry frame.
+    pub telemetry: Option<Telemetry>,
+    /// Telemetry frames per second, in thousandths.
+    pub rate_millihertz: u32,
+    /// Frames taken whole, BCC right.
+    pub frames: u32,
+    /// Whole frames whose BCC did not match.
+    pub bad_checksum: u32,
+    /// Bytes the parser threw away.
+    pub discarded: u32,
+    /// Times the failsafe sent the forced stop.
+    pub failsafe_stops: u32,
+}
+
+/// Draws the v1.0.0 board's whole screen.
+pub fn render(frame: &mut Frame<'_>, view: &View) {
+    let status = &view.status;
+    let [title, body, keys] = Layout::vertical([
+        Constraint::Length(1),
+        Constraint::Min(10),
+        Constraint::Length(3),
+    ])
+    .areas(frame.area());
+    title_bar(
+        frame,
+        title,
+        &status.port,
+        status.link_alive,
+        status.stale_ms,
+        "  firmware v1.0.0".into(),
+    );
+    let [top, drive_area] =
+        Layout::vertical([Constraint::Length(10), Constraint::Min(4)]).areas(body);
+    let [left, right] =
+        Layout::horizontal([Constraint::Percentage(55), Constraint::Percentage(45)]).areas(top);
+    let [measured_area, imu_area] =
+        Layout::vertical([Constraint::Length(4), Constraint::Length(5)]).areas(left);
+    let stale = if status.stale_ms.is_some() {
+        " (stale)"
+    } else {
+        ""
+    };
+    let (measured, imu) = match view.telemetry {
+        Some(t) => {
+            let [vx, vy, wz] = t.velocity.map(i32::from);
+            let [ax, ay, az] = t.accel;
+            let [gx, gy, gz] = t.gyro;
+            let [qw, qx, qy, qz] = t.quaternion;
+            (
+                vec![
+                    Line::from(format!(
+                        "vx {:>7} m/s  vy {:>7} m/s  wz {:>7} rad/s",
+                        units(vx),
+                        units(vy),
+                        units(wz)
+                    )),
+                    Line::from(match yaw_degrees(t.quaternion) {
+                        Some(yaw) => format!("yaw {yaw:>7.1}°  (from the quaternion)"),
+                        None => "yaw —  (the quaternion is all zero)".into(),
+                    }),
+                ],
+                vec![
+                    Line::from(format!("accel raw  x {ax:>6}  y {ay:>6}  z {az:>6}")),
+                    Line::from(format!("gyro raw   x {gx:>6}  y {gy:>6}  z {gz:>6}")),
+                    Line::from(format!(
+                        "quaternion ×1000  w {qw:>5}  x {qx:>5}  y {qy:>5}  z {qz:>5}"
+                    )),
+                ],
+            )
+        }
+        None => (
+            vec![Line::from("waiting for the telemetry…")],
+            vec![Line::from("—")],
+        ),
+    };
+    frame.render_widget(
+        Paragraph::new(measured).block(Block::bordered().title(format!(" measured{stale} "))),
+        measured_area,
+    );
+    frame.render_widget(
+        Paragraph::new(imu).block(
+            Block::bordered().title(format!(" IMU (gyro, accel raw: scale unknown){stale} ")),
+        ),
+        imu_area,
+    );
+
+    let [battery_area, link_area] =
+        Layout::vertical([Constraint::Length(3), Constraint::Length(7)]).areas(right);
+    let battery = view.telemetry.map(|t| i32::from(t.battery_mv));
+    frame.render_widget(
+        Paragraph::new(battery.map_or_else(
+            || "—".to_string(),
+            |mv| format!("{:.2} V  ({mv} mV)", f64::from(mv) / 1000.0),
+        ))
+        .style(Style::new().fg(match battery {
+            Some(mv) if mv >= 10_500 => Color::Green,
+            Some(_) => Color::Red,
+            None => Color::Reset,
+        }))
+        .block(Block::bordered().title(" battery ")),
+        battery_area,
+    );
+    frame.render_widget(
+        Paragraph::new(vec![
+            Line::from(format!(
+                "telemetry       {}",
+                rate_text(view.rate_millihertz, status.stale_ms)
+            )),
+            Line::from(format!("frames good     {}", view.frames)),
+            Line::from(format!("bad BCC         {}", view.bad_checksum)),
+            Line::from(format!("bytes discarded {}", view.discarded)),
+            Line::from(format!("failsafe stops  {}", view.failsafe_stops)),
+        ])
+        .block(Block::bordered().title(" link ")),
+        link_area,
+    );
+    let [vx, vy, wz] = status.velocity;
+    drive_panel(
+        frame,
+        drive_area,
+        status.driving,
+        status.held,
+        format!(
+            "driving at {} m/s: vx {} vy {} m/s, wz {} rad/s",
+            units(status.speed),
+            units(vx),
+            units(vy),
+            units(wz)
+        ),
+        &status.message,
+    );
+    keys_bar(
+        frame,
+        keys,
+        status.driving,
+        "arrows/WASD drive  z/x rotate 0.5 rad/s  space forced stop  +/- speed  q or Ctrl-C quit",
+    );
+}
+
+/// A driver error as one line, in the CLI's words.
+fn explain(driver: &BoardV1, e: Error<SerialError>) -> String {
+    match e {
+        Error::Transport(e) => format!("serial port {}: {}", driver.uart().name(), e.0),
+        other => other.to_string(),
+    }
+}
+
+/// A velocity component as the frame's 16 bits (the keys never go past ±2000).
+fn i16_of(v: i32) -> i16 {
+    i16::try_from(v).unwrap_or(if v < 0 { i16::MIN } else { i16::MAX })
+}
+
+/// The v1.0.0 board under the monitor.
+pub struct BoardV1Chassis {
+    driver: BoardV1,
+}
+
+impl BoardV1Chassis {
+    /// The board behind `driver`.
+    pub fn new(driver: BoardV1) -> Self {
+        BoardV1Chassis { driver }
+    }
+}
+
+impl Chassis for BoardV1Chassis {
+    type View = View;
+
+    fn port(&self) -> &str {
+        self.driver.uart().name()
+    }
+
+    fn poll(&mut self) -> Result<bool, String> {
+        match self.driver.poll() {
+            Ok(event) => Ok(event.is_some()),
+            Err(e) => Err(explain(&self.driver, e)),
+        }
+    }
+
+    fn failsafe_stops(&self) -> u32 {
+        self.driver.core().failsafe_stops()
+    }
+
+    fn drive(&mut self, velocity: [i32; 3]) -> Result<(), String> {
+        let [vx, vy, wz] = velocity.map(i16_of);
+        self.driver
+            .set_velocity(BodyVelocity::new(vx, vy, wz))
+            .map_err(|e| explain(&self.driver, e))
+    }
+
+    fn stop(&mut self) -> Result<(), String> {
+        self.driver.stop().map_err(|e| explain(&self.driver, e))
+    }
+
+    fn rotate_rate(&self) -> Result<i32, &'static str> {
+        Ok(ROTATE_MRAD_S)
+    }
+
+    fn turn(&mut self, _alive: bool) -> Result<String, String> {
+        Err(NO_TURN.into())
+    }
+
+    fn follow_up(&mut self) -> Option<String> {
+        None
+    }
+
+    fn view(&self, status: Status) -> View {
+        let core = self.driver.core();
+        let stats = core.parser_stats();
+        View {
+            status,
+            telemetry: core.telemetry().map(|s| s.value),
+            rate_millihertz: core.stream().rate_millihertz,
+            frames: stats.frames,
+            bad_checksum: stats.bad_checksum,
+            discarded: stats.discarded,
+            failsafe_stops: core.failsafe_stops(),
+        }
+    }
+
+    fn render(frame: &mut Frame<'_>, view: &View) {
+        render(frame, view);
+    }
+}
+
+/// `chassis monitor [--drive]` on a v1.0.0 board: the keys drive at `speed` mm/s.
+pub fn run(port: &str, drive: bool, speed: i32) -> Result<(), String> {
+    super::run_monitor(
+        || crate::port::open_v1(port, None).map(BoardV1Chassis::new),
+        drive,
+        speed,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ratatui::Terminal;
+    use ratatui::backend::TestBackend;
+
+    fn screen(view: &View) -> String {
+        let mut terminal = Terminal::new(TestBackend::new(100, 24)).unwrap();
+        terminal.draw(|f| render(f, view)).unwrap();
+        let buffer = terminal.backend().buffer().clone();
+        let mut text = String::new();
+        for y in 0..buffer.area.height {
+            for x in 0..buffer.area.width {
+                text.push_str(buffer[(x, y)].symbol());
+            }
+            text.push('\n');
+        }
+        text
+    }
+
+    fn close(got: Option<f64>, want: f64) {
+        let got = got.expect("a yaw");
+        assert!((got - want).abs() < 0.1, "yaw {got}, want {want}");
+    }
+
+    #[test]
+    fn the_yaw_comes_from_the_quaternion() {
+        // No rotation.
+        close(yaw_degrees([1000, 0, 0, 0]), 0.0);
+        // About z by θ: (cos θ/2, 0, 0, sin θ/2), × 1000 and rounded.
+        close(yaw_degrees([707, 0, 0, 707]), 90.0);
+        close(yaw_degrees([707, 0, 0, -707]), -90.0);
+        close(yaw_degrees([966, 0, 0, 259]), 30.0);
+        close(yaw_degrees([259, 0, 0, 966]), 150.0);
+        // Half a turn is 180, whichever sign the quaternion has.
+        close(yaw_degrees([0, 0, 0, 1000]), 180.0);
+        close(yaw_degrees([0, 0, 0, -1000]), 180.0);
+        // q and -q are the same rotation.
+        close(yaw_degrees([-966, 0, 0, -259]), 30.0);
+        // A quaternion a little off unit length gives the same heading.
+        close(yaw_degrees([700, 0, 0, 700]), 90.0);
+        // Tilted (roll 90° about x, then yaw 90°): the xy term counts.
+        close(yaw_degrees([500, 500, 500, 500]), 90.0);
+        assert_eq!(yaw_degrees([0; 4]), None);
+    }
+
+    #[test]
+    fn the_screen_shows_the_telemetry_the_counters_and_the_keys() {
+        let view = View {
+            status: Status {
+                port: "/dev/ttyUSB0".into(),
+                link_alive: true,
+                stale_ms: None,
+                driving: true,
+                held: false,
+                speed: 300,
+                velocity: [0, 300, 0],
+                message: NO_TURN.into(),
+            },
+            telemetry: Some(Telemetry {
+                velocity: [-120, 300, 500],
+                accel: [3, -4, 1000],
+                gyro: [1, -2, 500],
+                quaternion: [707, 0, 0, 707],
+                battery_mv: 11_870,
+            }),
+            rate_millihertz: 22_200,
+            frames: 1_203,
+            bad_checksum: 4,
+            discarded: 17,
+            failsafe_stops: 1,
+        };
+        let text = screen(&view);
+        for needle in [
+            "chassis monitor",
+            "/dev/ttyUSB0",
+            "LINK UP",
+            "firmware v1.0.0",
+            "vx  -0.120 m/s  vy   0.300 m/s  wz   0.500 rad/s",
+            "yaw    90.0°",
+            "accel raw  x      3  y     -4  z   1000",
+            "gyro raw   x      1  y     -2  z    500",
+            "w   707  x     0  y     0  z   707",
+            "scale unknown",
+            "11.87 V  (11870 mV)",
+            "telemetry       22.2 Hz",
+            "frames good     1203",
+            "bad BCC         4",
+            "bytes discarded 17",
+            "failsafe stops  1",
+            "driving at 0.300 m/s: vx 0.000 vy 0.300 m/s, wz 0.000 rad/s",
+            "no turn by an angle on v1.0.0",
+            "z/x rotate 0.5 rad/s",
+            "space forced stop",
+            "q or Ctrl-C quit",
+        ] {
+            assert!(text.contains(needle), "{needle:?} on the screen:\n{text}");
+        }
+        assert!(!text.contains("t turn"), "no turn key on v1.0.0:\n{text}");
+    }
+
+    #[test]
+    fn a_board_gone_quiet_shows_stale_figures_and_the_hold() {
+        let text = screen(&View {
+            status: Status {
+                port: "/dev/ttyUSB0".into(),
+                stale_ms: Some(3_200),
+                driving: true,
+                held: true,
+                ..Status::default()
+            },
+            telemetry: Some(Telemetry {
+                battery_mv: 12_000,
+                quaternion: [1000, 0, 0, 0],
+                ..Telemetry::default()
+            }),
+            rate_millihertz: 22_000,
+            failsafe_stops: 1,
+            ..View::default()
+        });
+        for needle in [
+            "NO LINK",
+            "STALE 3.2 s",
+            "measured (stale)",
+            "telemetry       stale",
+            "stopped by the failsafe: press a key",
+            "failsafe stops  1",
+            "12.00 V",
+        ] {
+            assert!(text.contains(needle), "{needle:?} on the screen:\n{text}");
+        }
+        assert!(
+            !text.contains("22.0 Hz"),
+            "no rate shown as if live:\n{text}"
+        );
+    }
+
+    #[test]
+    fn a_silent_board_shows_no_link_and_waits() {
+        let text = screen(&View {
+            status: Status {
+                port: "/dev/ttyACM0".into(),
+                ..Status::default()
+            },
+            ..View::default()
+        });
+        for needle in [
+            "NO LINK",
+            "waiting for the telemetry",
+            "read only (start with --drive to drive)",
+            "q quit",
+        ] {
+            assert!(text.contains(needle), "{needle:?} on the screen:\n{text}");
+        }
+    }
+}
