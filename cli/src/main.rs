@@ -33,7 +33,6 @@ macro_rules! tell_partial {
 
 mod check;
 mod connect;
-mod decode;
 mod device;
 mod encode;
 mod monitor;
@@ -46,6 +45,7 @@ mod sim;
 mod v1cmd;
 mod value;
 
+use chassis_capture as decode;
 use chassis_protocol::detect::Firmware;
 use clap::{Parser, Subcommand};
 use names::RegisterName;

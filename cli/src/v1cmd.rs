@@ -7,9 +7,9 @@
 
 use crate::port::{self, BoardV1};
 use crate::signals;
+use chassis_protocol::driver::Error;
 use chassis_protocol::driver::host::SerialError;
 use chassis_protocol::driver::v1::Settings;
-use chassis_protocol::driver::Error;
 use chassis_protocol::v1::{
     BodyVelocity, FIELDS, FieldError, Geometry, Pid, Readback, Reply, SystemSettings,
 };
@@ -69,7 +69,9 @@ pub fn get(path: &str, name: &str) -> Result<(), String> {
     let reply = readback(&mut driver, request)?;
     match field {
         Some((n, _)) => {
-            let value = reply.field(n).ok_or_else(|| format!("no {n} in the reply"))?;
+            let value = reply
+                .field(n)
+                .ok_or_else(|| format!("no {n} in the reply"))?;
             say!("{n}: {value}");
         }
         None => say!("{}", reply_json(&reply)),
@@ -96,7 +98,9 @@ pub fn set(path: &str, name: &str, value: &str) -> Result<(), String> {
     let mut driver = port::open_v1(path, None)?;
     let reply = readback(&mut driver, request)?;
     let settings = reply.with_field(field, value).map_err(|e| match e {
-        FieldError::OutOfRange => format!("{field}: {value} is out of range (0..=255, a bit field)"),
+        FieldError::OutOfRange => {
+            format!("{field}: {value} is out of range (0..=255, a bit field)")
+        }
         FieldError::NotHere => format!("{field}: the board's readback does not hold it"),
     })?;
     driver

@@ -1,5 +1,5 @@
-//! `chassis decode`: a capture in, one JSON object per frame per line out (JSON Lines), in
-//! stream order, and a one-line summary on stderr.
+//! The decoder of `chassis decode` and of the Python package's `decode_capture`: a capture
+//! in, one JSON object per frame out (JSON Lines), in stream order, and a one-line summary.
 //!
 //! The JSON is a public contract (documented in the README): every object has `"offset"` (the
 //! byte offset of the frame's first byte in the input) and `"frame"`, the fields of its kind,
@@ -17,7 +17,8 @@ use chassis_protocol::{Command, Downlink, DownlinkParser, Register, Setting, Upl
 use serde_json::{Map, Value, json};
 
 /// How the input is written.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Input {
     /// The bytes themselves.
     Raw,
@@ -29,7 +30,8 @@ pub enum Input {
 }
 
 /// How frames are written.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Format {
     /// One JSON object per line.
     Json,
@@ -990,10 +992,10 @@ mod tests {
         }
     }
 
-    const V1_DOWNLINK: &str = include_str!("../tests/golden/v1_downlink.hex");
-    const V1_UPLINK: &str = include_str!("../tests/golden/v1_uplink.hex");
-    const DOWNLINK_2020: &str = include_str!("../tests/golden/downlink.hex");
-    const UPLINK_2020: &str = include_str!("../tests/golden/uplink.hex");
+    const V1_DOWNLINK: &str = include_str!("../../cli/tests/golden/v1_downlink.hex");
+    const V1_UPLINK: &str = include_str!("../../cli/tests/golden/v1_uplink.hex");
+    const DOWNLINK_2020: &str = include_str!("../../cli/tests/golden/downlink.hex");
+    const UPLINK_2020: &str = include_str!("../../cli/tests/golden/uplink.hex");
 
     #[test]
     fn a_given_generation_skips_detection() {

@@ -1,0 +1,136 @@
+"""Drive the OminiBot HV chassis motor-controller board from Python.
+
+The same trusted core as the Rust crate ``chassis-protocol`` (this package is that crate,
+compiled): a driver with a failsafe and a one-shot turn guard, the frames and streaming parsers
+of both firmware generations (2020: ``FF FE`` frames; v1.0.0: ``7B … BCC 7D``), and simulated
+boards to try it all without hardware.
+
+>>> import chassis
+>>> with chassis.sim.pty() as board, chassis.open(board.path) as bot:
+...     bot.read("motor-voltage")
+1200
+
+Leaving a ``with`` block, an exception, ``KeyboardInterrupt``, ``close()``, the object being
+collected or the interpreter exiting stops the chassis.
+"""
+
+from __future__ import annotations
+
+import atexit
+import weakref
+from typing import Optional, Union
+
+from . import sim
+from .chassis_native import (
+    Action,
+    Battery,
+    BodyVelocity,
+    Chassis,
+    ChassisError,
+    ChassisV1,
+    DownlinkParser,
+    Encoders,
+    FrameError,
+    Imu,
+    Motors,
+    Read,
+    ReadbackReply,
+    Reply,
+    SystemMode,
+    Telemetry,
+    TimeoutError,
+    TransportError,
+    Turn,
+    TurnInProgressError,
+    UnconfirmedError,
+    UplinkParser,
+    V1DownlinkParser,
+    V1UplinkParser,
+    Velocity,
+    Write,
+    WrongReplyError,
+    Decoded,
+    __version__,
+    decode_capture,
+)
+from .chassis_native import open as _open
+
+__all__ = [
+    "Action",
+    "Battery",
+    "BodyVelocity",
+    "Chassis",
+    "ChassisError",
+    "ChassisV1",
+    "DownlinkParser",
+    "Encoders",
+    "FrameError",
+    "Imu",
+    "Motors",
+    "Read",
+    "ReadbackReply",
+    "Reply",
+    "SystemMode",
+    "Telemetry",
+    "TimeoutError",
+    "TransportError",
+    "Turn",
+    "TurnInProgressError",
+    "UnconfirmedError",
+    "UplinkParser",
+    "V1DownlinkParser",
+    "V1UplinkParser",
+    "Velocity",
+    "Write",
+    "WrongReplyError",
+    "Decoded",
+    "__version__",
+    "decode_capture",
+    "open",
+    "sim",
+]
+
+# Every chassis still open when the interpreter exits is stopped and closed.
+_open_chassis: "weakref.WeakSet[Union[Chassis, ChassisV1]]" = weakref.WeakSet()
+
+
+def open(
+    port: str,
+    *,
+    firmware: Optional[str] = None,
+    failsafe_ms: Optional[int] = None,
+    board_latency_ms: Optional[int] = None,
+    idle_ms: Optional[int] = None,
+    read_tries: Optional[int] = None,
+) -> Union[Chassis, ChassisV1]:
+    """Open the board on serial port ``port`` and return its driver.
+
+    Without ``firmware`` ("2020" or "v1.0.0"), the firmware is found from what the board
+    sends (it listens first; only on a quiet line does it send a register read of each
+    firmware, never anything else). Returns a :class:`Chassis` (2020) or a :class:`ChassisV1`
+    (v1.0.0), with the host defaults (a 200 ms failsafe; at least 300 ms on v1.0.0) changed by
+    the keyword arguments, and its pump thread running: the failsafe and the telemetry run
+    whatever the program does.
+
+    Raises :class:`TimeoutError` when nothing came from the board, :class:`TransportError`
+    when the port cannot be opened, :class:`ChassisError` on bytes of neither firmware.
+    """
+    bot = _open(
+        port,
+        firmware=firmware,
+        failsafe_ms=failsafe_ms,
+        board_latency_ms=board_latency_ms,
+        idle_ms=idle_ms,
+        read_tries=read_tries,
+    )
+    _open_chassis.add(bot)
+    return bot
+
+
+@atexit.register
+def _stop_all() -> None:
+    for bot in list(_open_chassis):
+        try:
+            bot.close()
+        except ChassisError:
+            pass

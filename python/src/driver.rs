@@ -1,0 +1,1068 @@
+//! `Chassis` (the 2020 firmware) and `ChassisV1` (v1.0.0): the crate's host driver over a serial
+//! port, with a pump thread of its own, so that the failsafe and the telemetry run whatever the
+//! Python program does (sleeps, computes, waits on a ROS callback). Every blocking call releases
+//! the GIL; the driver sits behind a mutex, so a second thread can call `stop()` while another
+//! waits.
+
+use crate::errors::{self, ChassisError, TurnInProgressError, driver_error};
+use crate::frames;
+use chassis_protocol as p;
+use chassis_protocol::detect::{self, Firmware};
+use chassis_protocol::driver::blocking::Driver;
+use chassis_protocol::driver::host::{MonotonicClock, SerialError, SerialPort};
+use chassis_protocol::driver::{
+    Config, Core, DriverCore, Error, Event, Outcome, Request, TurnState, v1,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::collections::VecDeque;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// Frames kept for `poll()` (a program that never polls loses the oldest, never blocks the
+/// driver): 1 024 frames are 8 s of the 2020 board's telemetry.
+const QUEUE: usize = 1_024;
+
+/// How often the pump thread takes in what arrived and judges time (the failsafe).
+const PUMP_EVERY: Duration = Duration::from_millis(2);
+
+/// What the pump thread and the Python calls share.
+struct State<K: Core> {
+    driver: Option<Driver<SerialPort, MonotonicClock, K>>,
+    events: VecDeque<K::Event>,
+    /// Frames thrown away because nobody polled.
+    overflowed: u64,
+    /// The last error the pump thread met (the port unplugged), said once.
+    pump_error: Option<String>,
+}
+
+/// A driver with its pump thread.
+pub struct Link<K: Core> {
+    state: Arc<Mutex<State<K>>>,
+    /// A copy of the driver's clock (the same origin).
+    clock: MonotonicClock,
+    running: Arc<AtomicBool>,
+    pump: Option<JoinHandle<()>>,
+    /// The port's path.
+    pub port: String,
+}
+
+fn lock<K: Core>(state: &Mutex<State<K>>) -> MutexGuard<'_, State<K>> {
+    state
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// What the Python side needs of each generation's core to word its errors.
+pub trait Heard {
+    /// Whether nothing at all came from the board.
+    fn silent(&self) -> bool;
+}
+
+impl Heard for DriverCore {
+    fn silent(&self) -> bool {
+        self.last_heard_ms().is_none()
+    }
+}
+
+impl Heard for v1::DriverCore {
+    fn silent(&self) -> bool {
+        self.last_heard_ms().is_none()
+    }
+}
+
+impl<K> Link<K>
+where
+    K: Core + Heard + Send + 'static,
+    K::Event: Send,
+{
+    /// Starts the pump thread over `driver`.
+    fn start(
+        driver: Driver<SerialPort, MonotonicClock, K>,
+        clock: MonotonicClock,
+        port: String,
+    ) -> Self {
+        let state = Arc::new(Mutex::new(State {
+            driver: Some(driver),
+            events: VecDeque::new(),
+            overflowed: 0,
+            pump_error: None,
+        }));
+        let running = Arc::new(AtomicBool::new(true));
+        let pump = {
+            let state = Arc::clone(&state);
+            let running = Arc::clone(&running);
+            std::thread::Builder::new()
+                .name("chassis-pump".into())
+                .spawn(move || pump(&state, &running))
+                .ok()
+        };
+        Link {
+            state,
+            clock,
+            running,
+            pump,
+            port,
+        }
+    }
+
+    /// Runs `f` on the driver with the GIL released; `ChassisError` once closed.
+    pub fn with<R: Send>(
+        &self,
+        py: Python<'_>,
+        f: impl FnOnce(&mut Driver<SerialPort, MonotonicClock, K>) -> Result<R, Error<SerialError>>
+        + Send,
+    ) -> PyResult<R> {
+        let port = self.port.as_str();
+        py.detach(|| {
+            let mut state = lock(&self.state);
+            let Some(driver) = state.driver.as_mut() else {
+                return Err(closed(port));
+            };
+            f(driver).map_err(|e| driver_error(e, driver.core().silent(), port))
+        })
+    }
+
+    /// Reads the core (no I/O).
+    pub fn core<R>(&self, f: impl FnOnce(&K) -> R) -> PyResult<R> {
+        let state = lock(&self.state);
+        state
+            .driver
+            .as_ref()
+            .map(|d| f(d.core()))
+            .ok_or_else(|| closed(&self.port))
+    }
+
+    /// The next frame the pump took in, if any.
+    pub fn next_event(&self) -> PyResult<Option<K::Event>> {
+        let mut state = lock(&self.state);
+        if state.driver.is_none() {
+            return Err(closed(&self.port));
+        }
+        if let Some(e) = state.pump_error.take() {
+            return Err(errors::TransportError::new_err(e));
+        }
+        Ok(state.events.pop_front())
+    }
+
+    /// The driver's clock now.
+    pub fn now_ms(&self) -> u64 {
+        use chassis_protocol::driver::Clock as _;
+        let mut clock = self.clock;
+        clock.now_ms()
+    }
+
+    /// Frames thrown away because nobody polled.
+    pub fn overflowed(&self) -> u64 {
+        lock(&self.state).overflowed
+    }
+
+    /// Stops the chassis (best effort), ends the pump and closes the port.
+    pub fn close(&mut self, py: Python<'_>) -> PyResult<()> {
+        let result = self.with(py, |d| d.stop());
+        self.shut();
+        match result {
+            Err(e) if e.is_instance_of::<ChassisError>(py) && is_closed(&e, py) => Ok(()),
+            other => other,
+        }
+    }
+
+    /// Ends the pump thread and drops the driver (no I/O).
+    fn shut(&mut self) {
+        self.running.store(false, Ordering::SeqCst);
+        if let Some(t) = self.pump.take() {
+            let _ = t.join();
+        }
+        lock(&self.state).driver = None;
+    }
+}
+
+impl<K: Core> Drop for Link<K> {
+    fn drop(&mut self) {
+        // Collected without `close()`: stop the chassis before the port goes.
+        self.running.store(false, Ordering::SeqCst);
+        if let Some(t) = self.pump.take() {
+            let _ = t.join();
+        }
+        let mut state = lock(&self.state);
+        if let Some(driver) = state.driver.as_mut() {
+            let _ = driver.stop();
+        }
+        state.driver = None;
+    }
+}
+
+/// The pump thread: takes in what arrived and judges time, every [`PUMP_EVERY`].
+fn pump<K: Core>(state: &Mutex<State<K>>, running: &AtomicBool) {
+    while running.load(Ordering::SeqCst) {
+        {
+            let mut guard = lock(state);
+            let st = &mut *guard;
+            let Some(driver) = st.driver.as_mut() else {
+                return;
+            };
+            for _ in 0..64 {
+                match driver.poll() {
+                    Ok(Some(event)) => {
+                        if st.events.len() >= QUEUE {
+                            st.events.pop_front();
+                            st.overflowed = st.overflowed.saturating_add(1);
+                        }
+                        st.events.push_back(event);
+                    }
+                    Ok(None) => break,
+                    Err(e) => {
+                        st.pump_error = Some(match e {
+                            Error::Transport(e) => format!("serial port: {}", e.0),
+                            other => other.to_string(),
+                        });
+                        break;
+                    }
+                }
+            }
+        }
+        std::thread::sleep(PUMP_EVERY);
+    }
+}
+
+fn closed(port: &str) -> PyErr {
+    ChassisError::new_err(format!("the chassis on {port} is closed"))
+}
+
+fn is_closed(e: &PyErr, py: Python<'_>) -> bool {
+    e.value(py).to_string().ends_with("is closed")
+}
+
+/// The host configuration with the caller's changes.
+fn config(
+    failsafe_ms: Option<u32>,
+    board_latency_ms: Option<u32>,
+    idle_ms: Option<u32>,
+    read_tries: Option<u8>,
+) -> Config {
+    let mut c = Config::HOST;
+    if let Some(v) = failsafe_ms {
+        c.failsafe_ms = v;
+    }
+    if let Some(v) = board_latency_ms {
+        c.board_latency_ms = v;
+    }
+    if let Some(v) = idle_ms {
+        c.idle_ms = v;
+    }
+    if let Some(v) = read_tries {
+        c.read_tries = v;
+    }
+    c
+}
+
+/// The generation's name as `firmware=` takes it.
+fn firmware_of(name: &str) -> PyResult<Firmware> {
+    match name {
+        "2020" => Ok(Firmware::V2020),
+        "v1.0.0" | "v1" => Ok(Firmware::V1_0_0),
+        _ => Err(PyValueError::new_err(format!(
+            "firmware={name:?}: the board runs 2020 or v1.0.0"
+        ))),
+    }
+}
+
+/// Opens `port` (a serial port path), finds the firmware if not given, and returns a `Chassis`
+/// (2020) or a `ChassisV1` (v1.0.0) with the host defaults and its pump thread running.
+#[pyfunction]
+#[pyo3(signature = (port, *, firmware = None, failsafe_ms = None, board_latency_ms = None, idle_ms = None, read_tries = None))]
+pub fn open(
+    py: Python<'_>,
+    port: &str,
+    firmware: Option<&str>,
+    failsafe_ms: Option<u32>,
+    board_latency_ms: Option<u32>,
+    idle_ms: Option<u32>,
+    read_tries: Option<u8>,
+) -> PyResult<Py<PyAny>> {
+    let config = config(failsafe_ms, board_latency_ms, idle_ms, read_tries);
+    let given = firmware.map(firmware_of).transpose()?;
+    let path = port.to_string();
+    let opened = py.detach(|| -> Result<(SerialPort, Firmware), PyErr> {
+        let mut serial = SerialPort::open(&path).map_err(|e| {
+            errors::TransportError::new_err(format!("cannot open {path}: {}", e.0))
+        })?;
+        let firmware = match given {
+            Some(f) => f,
+            None => {
+                let mut clock = MonotonicClock::new();
+                let found = detect::detect(&mut serial, &mut clock, &config).map_err(|e| {
+                    errors::TransportError::new_err(format!("serial port {path}: {}", e.0))
+                })?;
+                match found.firmware {
+                    Some(f) => f,
+                    None if found.heard.bytes == 0 => {
+                        return Err(errors::TimeoutError::new_err(format!(
+                            "nothing came from the board on {path} in {:.1} s, not even an answer to a register read of either firmware (is it powered, TX wired to RX and RX to TX, at 115200 bps?); firmware=\"2020\" or \"v1.0.0\" skips this check",
+                            found.elapsed_ms as f64 / 1000.0
+                        )));
+                    }
+                    None => {
+                        return Err(ChassisError::new_err(format!(
+                            "{} bytes came from {path}, but no frame of either firmware: another device, or a baud rate other than 115200?",
+                            found.heard.bytes
+                        )));
+                    }
+                }
+            }
+        };
+        Ok((serial, firmware))
+    })?;
+    let (serial, firmware) = opened;
+    let clock = MonotonicClock::new();
+    Ok(match firmware {
+        Firmware::V2020 => {
+            let driver = Driver::new(serial, clock, config);
+            Chassis {
+                link: Link::start(driver, clock, port.to_string()),
+            }
+            .into_pyobject(py)?
+            .into_any()
+            .unbind()
+        }
+        Firmware::V1_0_0 => {
+            let driver = Driver::new_v1(serial, clock, config);
+            ChassisV1 {
+                link: Link::start(driver, clock, port.to_string()),
+            }
+            .into_pyobject(py)?
+            .into_any()
+            .unbind()
+        }
+    })
+}
+
+/// Waits until `until` or a frame, polling the queue, the GIL released between looks and
+/// signals checked (Ctrl-C raises `KeyboardInterrupt`).
+fn wait_event<K>(link: &Link<K>, py: Python<'_>, timeout: Option<f64>) -> PyResult<Option<K::Event>>
+where
+    K: Core + Heard + Send + 'static,
+    K::Event: Send,
+{
+    let end = timeout.map(|t| Instant::now() + Duration::from_secs_f64(t.max(0.0)));
+    loop {
+        if let Some(e) = link.next_event()? {
+            return Ok(Some(e));
+        }
+        if end.is_some_and(|end| Instant::now() >= end) {
+            return Ok(None);
+        }
+        py.check_signals()?;
+        py.detach(|| std::thread::sleep(Duration::from_millis(2)));
+    }
+}
+
+fn stream_dict<'py>(py: Python<'py>, info: p::driver::StreamInfo) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("frames", info.frames)?;
+    d.set_item("missed", info.missed)?;
+    d.set_item("rate_hz", f64::from(info.rate_millihertz) / 1000.0)?;
+    Ok(d)
+}
+
+// ----- 2020 -----
+
+/// A chassis running the 2020 firmware, driven over a serial port (made by `chassis.open`).
+///
+/// Leaving a `with` block, an exception in it, `KeyboardInterrupt`, `close()` or the object
+/// being collected stops the chassis. While it moves, the driver's failsafe stops it when the
+/// board has been silent for `failsafe_ms` (200 ms), whatever the program is doing.
+#[pyclass(module = "chassis", weakref)]
+pub struct Chassis {
+    link: Link<DriverCore>,
+}
+
+/// What `read` returns for a register.
+fn typed_value(py: Python<'_>, register: p::Register, raw: u32) -> PyResult<Py<PyAny>> {
+    Ok(match register {
+        p::Register::PendingAngle => (f64::from(raw as i32) / 10.0)
+            .into_pyobject(py)?
+            .into_any()
+            .unbind(),
+        p::Register::SystemMode => SystemMode::from(p::SystemMode::from_bits(raw))
+            .into_pyobject(py)?
+            .into_any()
+            .unbind(),
+        p::Register::BatteryRange => {
+            let volts = |v: u32| -> Option<f64> { (v != 0x7FFF).then(|| f64::from(v) / 100.0) };
+            (volts(raw >> 16), volts(raw & 0xFFFF))
+                .into_pyobject(py)?
+                .into_any()
+                .unbind()
+        }
+        _ => raw.into_pyobject(py)?.into_any().unbind(),
+    })
+}
+
+#[pymethods]
+impl Chassis {
+    /// `"2020"`.
+    #[getter]
+    fn firmware(&self) -> &'static str {
+        "2020"
+    }
+
+    /// The serial port's path.
+    #[getter]
+    fn port(&self) -> &str {
+        &self.link.port
+    }
+
+    /// Sets the body velocity (X sideways, Y forward, Z rotation; the board's raw units,
+    /// ±65535). Safe to call every period.
+    #[pyo3(signature = (x = 0, y = 0, z = 0))]
+    fn set_velocity(&self, py: Python<'_>, x: i32, y: i32, z: i32) -> PyResult<()> {
+        let v = frames::Velocity::new_checked(x, y, z)?;
+        self.link.with(py, |d| d.set_velocity(v))
+    }
+
+    /// Drives each motor: closed-loop speeds, or open-loop duty in 0.01 % (`open_loop=True`).
+    #[pyo3(signature = (values, open_loop = false))]
+    fn set_motors(&self, py: Python<'_>, values: [i32; 4], open_loop: bool) -> PyResult<()> {
+        let m = if open_loop {
+            p::Motors::open_loop_duty(values)
+        } else {
+            p::Motors::closed_loop(values)
+        };
+        self.link.with(py, |d| d.set_motors(m))
+    }
+
+    /// Stops the chassis; a turn in progress is cancelled (the angle still pending is read and
+    /// the opposite turn sent).
+    fn stop(&self, py: Python<'_>) -> PyResult<()> {
+        self.link.with(py, |d| d.stop())
+    }
+
+    /// Turns by `degrees` (0.1° steps), sent **once**: the board adds turns up, so while one is
+    /// outstanding another raises `TurnInProgressError` (nothing sent). `wait_turn()` waits
+    /// for it; `stop()` cancels it.
+    fn turn(&self, py: Python<'_>, degrees: f64) -> PyResult<()> {
+        if !(-6_553.5..=6_553.5).contains(&degrees) {
+            return Err(PyValueError::new_err(format!(
+                "{degrees}° is out of range (±6553.5)"
+            )));
+        }
+        let deci = (degrees * 10.0).round() as i32;
+        if deci == 0 {
+            return Err(PyValueError::new_err(format!(
+                "{degrees}° rounds to 0.0° (the board turns in steps of 0.1°): nothing sent"
+            )));
+        }
+        let result = self.link.with(py, |d| d.turn_by(deci));
+        if let Err(e) = &result {
+            if e.is_instance_of::<TurnInProgressError>(py) {
+                let left = self.link.core(|c| match c.turn_state() {
+                    TurnState::Turning { deci_degrees } => f64::from(deci_degrees) / 10.0,
+                    _ => 0.0,
+                })?;
+                return Err(TurnInProgressError::new_err(format!(
+                    "the board still has {left:.1}° of an earlier turn pending (it adds turns up): not sent; wait for it to end, or stop() cancels it"
+                )));
+            }
+        }
+        result
+    }
+
+    /// Waits until the turn is done (the pending angle reads 0): `True`, or `False` after
+    /// `timeout` seconds. `KeyboardInterrupt` while waiting cancels the turn.
+    #[pyo3(signature = (timeout = None))]
+    fn wait_turn(&self, py: Python<'_>, timeout: Option<f64>) -> PyResult<bool> {
+        let end = timeout.map(|t| Instant::now() + Duration::from_secs_f64(t.max(0.0)));
+        loop {
+            if !self.link.core(DriverCore::turning)? {
+                return Ok(true);
+            }
+            if end.is_some_and(|end| Instant::now() >= end) {
+                return Ok(false);
+            }
+            if let Err(e) = py.check_signals() {
+                let _ = self.link.with(py, |d| d.stop());
+                return Err(e);
+            }
+            py.detach(|| std::thread::sleep(Duration::from_millis(100)));
+            // One lost reply is no reason to give up: the timeout bounds the wait.
+            let _ = self.link.with(py, |d| d.turn_remaining());
+        }
+    }
+
+    /// Reads a register by name (`max-speed`, `kp`, `ki`, `gyro-gain`, `system-mode`,
+    /// `gyro-calibration`, `motor-voltage`, `battery-range`, `pending-angle`), each read
+    /// verified (two replies must agree): an `int`; a `SystemMode`; `(full_volts,
+    /// cutoff_volts)` (`None` for the built-in table); the pending angle in degrees.
+    fn read(&self, py: Python<'_>, register: &str) -> PyResult<Py<PyAny>> {
+        let r = frames::register(register)?;
+        let raw = self
+            .link
+            .with(py, |d| match d.run(Request::ReadVerified(r))? {
+                Outcome::Value(v) => Ok(v),
+                _ => Ok(0),
+            })?;
+        typed_value(py, r, raw)
+    }
+
+    /// Writes a register and reads it back (`UnconfirmedError` if the board does not show the
+    /// value). A write that starts a 30 s gyro calibration (gyro-calibration 0xFFFF,
+    /// system-mode switching bit 3 on) needs `calibrate=True`.
+    #[pyo3(signature = (register, value, *, calibrate = false))]
+    fn write(&self, py: Python<'_>, register: &str, value: u32, calibrate: bool) -> PyResult<()> {
+        let write = frames::write_of(register, value)?;
+        let r = write.register();
+        let starts = match write {
+            p::Write::GyroCalibration(0xFFFF) => true,
+            p::Write::SystemMode(mode) if mode.gyro_compensation() => {
+                let now = self
+                    .link
+                    .with(py, |d| match d.run(Request::ReadVerified(r))? {
+                        Outcome::Value(v) => Ok(v),
+                        _ => Ok(0),
+                    })?;
+                !p::SystemMode::from_bits(now).gyro_compensation()
+            }
+            _ => false,
+        };
+        if starts && !calibrate {
+            return Err(PyValueError::new_err(
+                "this write starts a gyro calibration (30 s: the chassis must stay still); nothing written: pass calibrate=True to go ahead",
+            ));
+        }
+        let back = self.link.with(py, |d| {
+            d.write(write)?;
+            match d.run(Request::ReadVerified(r))? {
+                Outcome::Value(v) => Ok(v),
+                _ => Ok(0),
+            }
+        })?;
+        if back != write.value() && !(starts && r == p::Register::GyroCalibration) {
+            return Err(errors::UnconfirmedError::new_err(format!(
+                "{register}: {value} was written (the frame went out) but the board reads {back}"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Every register, each read verified, as a dict (the `chassis settings` JSON).
+    fn settings<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let snapshot = self.link.with(py, |d| d.read_settings())?;
+        let value =
+            serde_json::to_value(snapshot).map_err(|e| ChassisError::new_err(e.to_string()))?;
+        crate::json::to_dict(py, &value)
+    }
+
+    /// Writes settings back (a dict as `settings()` gives; never starts a gyro calibration),
+    /// reads every register back and returns what differs: `{name: (wanted, board)}` (empty
+    /// when all were restored; system-mode bit 3, gyro compensation, is kept as the board has
+    /// it).
+    fn restore<'py>(
+        &self,
+        py: Python<'py>,
+        settings: &Bound<'py, PyDict>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let value = crate::json::from_py(settings.as_any())?;
+        let wanted: p::Snapshot = serde_json::from_value(value)
+            .map_err(|e| PyValueError::new_err(format!("not a settings dict: {e}")))?;
+        let board = self.link.with(py, |d| {
+            d.restore_settings(&wanted)?;
+            d.read_settings()
+        })?;
+        let differs = PyDict::new(py);
+        let keep_bit3 = |m: p::SystemMode| m.with_gyro_compensation(false).bits();
+        for r in p::Snapshot::REGISTERS {
+            let (w, b) = (wanted.value(r), board.value(r));
+            let same = match r {
+                p::Register::SystemMode => {
+                    keep_bit3(wanted.system_mode) == keep_bit3(board.system_mode)
+                }
+                // A restore never writes the calibration value (0xFFFF would calibrate).
+                p::Register::GyroCalibration => true,
+                _ => w == b,
+            };
+            if !same {
+                differs.set_item(r.name(), (w, b))?;
+            }
+        }
+        Ok(differs)
+    }
+
+    /// The next frame the driver took in (`Imu`, `Encoders`, `Battery`, `Reply`), or `None`.
+    fn poll(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        match self.link.next_event()? {
+            Some(Event::Telemetry(f)) => Ok(Some(frames::downlink(py, f)?)),
+            Some(_) | None => Ok(None),
+        }
+    }
+
+    /// Waits up to `timeout` seconds (`None`: for ever) for the next frame.
+    #[pyo3(signature = (timeout = None))]
+    fn wait_frame(&self, py: Python<'_>, timeout: Option<f64>) -> PyResult<Option<Py<PyAny>>> {
+        loop {
+            match wait_event(&self.link, py, timeout)? {
+                Some(Event::Telemetry(f)) => return Ok(Some(frames::downlink(py, f)?)),
+                Some(_) => continue,
+                None => return Ok(None),
+            }
+        }
+    }
+
+    fn __iter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    fn __next__(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        match self.wait_frame(py, None) {
+            Err(e) if is_closed(&e, py) => Ok(None),
+            other => other,
+        }
+    }
+
+    /// Whether the board was heard within the failsafe time.
+    #[getter]
+    fn link_alive(&self) -> PyResult<bool> {
+        let now = self.link.now_ms();
+        self.link.core(|c| c.link_alive(now))
+    }
+
+    /// Whether the driver has the chassis moving (a turn outstanding counts).
+    #[getter]
+    fn moving(&self) -> PyResult<bool> {
+        self.link.core(DriverCore::moving)
+    }
+
+    /// Times the failsafe has stopped the chassis.
+    #[getter]
+    fn failsafe_stops(&self) -> PyResult<u32> {
+        self.link.core(DriverCore::failsafe_stops)
+    }
+
+    /// Per stream (`imu`, `encoders`, `battery`): frames, missed (by the counts), rate_hz.
+    #[getter]
+    fn streams<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let infos = self.link.core(|c| {
+            [p::Stream::Imu, p::Stream::Encoders, p::Stream::Battery].map(|s| (s, c.stream(s)))
+        })?;
+        let d = PyDict::new(py);
+        for (s, info) in infos {
+            d.set_item(format!("{s:?}").to_lowercase(), stream_dict(py, info)?)?;
+        }
+        Ok(d)
+    }
+
+    /// The parser's counters, and frames dropped because nobody polled.
+    #[getter]
+    fn counters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = self.link.core(|c| *c.parser_stats())?;
+        let d = PyDict::new(py);
+        d.set_item("frames", s.total_frames())?;
+        d.set_item("discarded", s.discarded)?;
+        d.set_item("resyncs", s.resyncs)?;
+        d.set_item("lock_losses", s.lock_losses)?;
+        d.set_item("not_polled", self.link.overflowed())?;
+        Ok(d)
+    }
+
+    /// The latest IMU frame (or `None`).
+    #[getter]
+    fn imu(&self) -> PyResult<Option<frames::Imu>> {
+        self.link.core(|c| c.imu().map(|s| s.value.into()))
+    }
+
+    /// The latest encoder frame (or `None`).
+    #[getter]
+    fn encoders(&self) -> PyResult<Option<frames::Encoders>> {
+        self.link.core(|c| c.encoders().map(|s| s.value.into()))
+    }
+
+    /// The latest battery frame (or `None`).
+    #[getter]
+    fn battery(&self) -> PyResult<Option<frames::Battery>> {
+        self.link.core(|c| c.battery().map(|s| s.value.into()))
+    }
+
+    /// Stops the chassis and closes the port (again: nothing).
+    fn close(&mut self, py: Python<'_>) -> PyResult<()> {
+        self.link.close(py)
+    }
+
+    fn __enter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    /// Stops the chassis and closes the port; an exception in the block goes on.
+    fn __exit__(
+        &mut self,
+        py: Python<'_>,
+        _kind: Option<Bound<'_, PyAny>>,
+        value: Option<Bound<'_, PyAny>>,
+        _traceback: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<bool> {
+        let closed = self.link.close(py);
+        if value.is_none() {
+            closed?;
+        }
+        Ok(false)
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Chassis(port={:?}, firmware=\"2020\")", self.link.port)
+    }
+}
+
+/// The system-mode register (0x09), by field.
+#[pyclass(module = "chassis", frozen, eq, from_py_object)]
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub struct SystemMode {
+    /// The raw bits.
+    #[pyo3(get)]
+    pub bits: u32,
+}
+
+impl SystemMode {
+    fn mode(&self) -> p::SystemMode {
+        p::SystemMode::from_bits(self.bits)
+    }
+}
+
+impl From<p::SystemMode> for SystemMode {
+    fn from(m: p::SystemMode) -> Self {
+        SystemMode { bits: m.bits() }
+    }
+}
+
+#[pymethods]
+impl SystemMode {
+    #[new]
+    fn new(bits: u32) -> Self {
+        SystemMode { bits }
+    }
+
+    /// `omni`, `mecanum`, `differential`, `differential-open-loop`.
+    #[getter]
+    fn drive_type(&self) -> &'static str {
+        match self.mode().drive_type() {
+            p::DriveType::Omni => "omni",
+            p::DriveType::Mecanum => "mecanum",
+            p::DriveType::Differential => "differential",
+            p::DriveType::DifferentialOpenLoop => "differential-open-loop",
+            p::DriveType::Reserved(_) => "reserved",
+        }
+    }
+
+    /// Bit 3: gyro compensation.
+    #[getter]
+    fn gyro_compensation(&self) -> bool {
+        self.mode().gyro_compensation()
+    }
+
+    /// Gyro correction at rest.
+    #[getter]
+    fn gyro_correction_at_rest(&self) -> bool {
+        self.mode().gyro_correction_at_rest()
+    }
+
+    /// Motor direction reversed.
+    #[getter]
+    fn motor_reversed(&self) -> bool {
+        self.mode().motor_reversed()
+    }
+
+    /// Encoder direction reversed.
+    #[getter]
+    fn encoder_reversed(&self) -> bool {
+        self.mode().encoder_reversed()
+    }
+
+    /// Steering reversed.
+    #[getter]
+    fn steering_reversed(&self) -> bool {
+        self.mode().steering_reversed()
+    }
+
+    /// Gyro direction reversed.
+    #[getter]
+    fn gyro_reversed(&self) -> bool {
+        self.mode().gyro_reversed()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "SystemMode(0x{:08X}: drive_type={:?}, gyro_compensation={})",
+            self.bits,
+            self.drive_type(),
+            if self.gyro_compensation() {
+                "True"
+            } else {
+                "False"
+            }
+        )
+    }
+}
+
+// ----- v1.0.0 -----
+
+/// A chassis running the v1.0.0 firmware (`7B … BCC 7D` frames), made by `chassis.open`. The
+/// same guarantees as `Chassis`; the failsafe sends the forced stop. There is no turn by an
+/// angle on v1.0.0, and no `turn` here.
+#[pyclass(module = "chassis", weakref)]
+pub struct ChassisV1 {
+    link: Link<v1::DriverCore>,
+}
+
+/// A speed in SI units as the board's thousandths.
+fn milli(value: f64, name: &str) -> PyResult<i16> {
+    let m = (value * 1000.0).round();
+    if !m.is_finite() || !(f64::from(i16::MIN)..=f64::from(i16::MAX)).contains(&m) {
+        return Err(PyValueError::new_err(format!(
+            "{name} = {value} is out of range (±32.767, the frame's 16 bits in thousandths)"
+        )));
+    }
+    Ok(m as i16)
+}
+
+#[pymethods]
+impl ChassisV1 {
+    /// `"v1.0.0"`.
+    #[getter]
+    fn firmware(&self) -> &'static str {
+        "v1.0.0"
+    }
+
+    /// The serial port's path.
+    #[getter]
+    fn port(&self) -> &str {
+        &self.link.port
+    }
+
+    /// Sets the body velocity: vx sideways and vy forward in m/s, wz in rad/s
+    /// (counter-clockwise). Safe to call every period.
+    #[pyo3(signature = (vx = 0.0, vy = 0.0, wz = 0.0))]
+    fn set_velocity(&self, py: Python<'_>, vx: f64, vy: f64, wz: f64) -> PyResult<()> {
+        let v = p::v1::BodyVelocity::new(milli(vx, "vx")?, milli(vy, "vy")?, milli(wz, "wz")?);
+        self.link.with(py, |d| d.set_velocity(v))
+    }
+
+    /// Drives each motor (`0x26`; the board's own unit, raw).
+    fn set_motors(&self, py: Python<'_>, speeds: [i16; 4]) -> PyResult<()> {
+        let m = p::v1::MotorVelocity::new(speeds);
+        self.link.with(py, |d| d.set_motors(m))
+    }
+
+    /// Sends the forced stop.
+    fn stop(&self, py: Python<'_>) -> PyResult<()> {
+        self.link.with(py, |d| d.stop())
+    }
+
+    /// A readback by name (`system`, `geometry`, `body-velocity`, `motor-speeds`, `pid`: a dict
+    /// of its fields) or one settings field (`wheel-diameter`, `pwm-max`, … : an `int`).
+    fn read<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        if let Some(r) = p::v1::Readback::from_name(name) {
+            let reply = self.link.with(py, |d| d.readback(r))?;
+            return Ok(frames::reply_fields(py, &reply)?.into_any());
+        }
+        let Some(r) = p::v1::field_readback(name) else {
+            return Err(PyValueError::new_err(format!(
+                "{name:?} is not a v1.0.0 readback or settings field: give one of {}, or {}",
+                p::v1::Readback::ALL.map(p::v1::Readback::name).join(", "),
+                p::v1::FIELDS.map(|(n, _)| n).join(", ")
+            )));
+        };
+        let reply = self.link.with(py, |d| d.readback(r))?;
+        let value = reply
+            .field(name)
+            .ok_or_else(|| ChassisError::new_err(format!("no {name} in the board's reply")))?;
+        Ok(value.into_pyobject(py)?.into_any())
+    }
+
+    /// Writes one settings field: its frame is read back, written with the field changed (at
+    /// least 100 ms after the previous settings frame), and read back again
+    /// (`UnconfirmedError` if the board does not show it).
+    fn write(&self, py: Python<'_>, name: &str, value: u16) -> PyResult<()> {
+        let Some(r) = p::v1::field_readback(name) else {
+            return Err(PyValueError::new_err(format!(
+                "{name:?} is not a v1.0.0 settings field: give one of {}",
+                p::v1::FIELDS.map(|(n, _)| n).join(", ")
+            )));
+        };
+        let reply = self.link.with(py, |d| d.readback(r))?;
+        let settings = reply.with_field(name, value).map_err(|e| match e {
+            p::v1::FieldError::OutOfRange => {
+                PyValueError::new_err(format!("{name} = {value} is out of range (0..=255)"))
+            }
+            p::v1::FieldError::NotHere => {
+                ChassisError::new_err(format!("the board's readback does not hold {name}"))
+            }
+        })?;
+        self.link.with(py, |d| d.write_settings(settings))
+    }
+
+    /// The three settings frames as a dict: `{"firmware": "v1.0.0", "system": {…},
+    /// "geometry": {…}, "pid": {…}}` (the `chassis settings` JSON).
+    fn settings<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let (system, geometry, pid) = self
+            .link
+            .with(py, |d| Ok((d.system()?, d.geometry()?, d.pid()?)))?;
+        let value = serde_json::json!({
+            "firmware": "v1.0.0",
+            "system": system,
+            "geometry": geometry,
+            "pid": pid,
+        });
+        crate::json::to_dict(py, &value)
+    }
+
+    /// Writes the three settings frames of a dict as `settings()` gives, each confirmed by its
+    /// readback (v1.0.0 keeps them until power-off).
+    fn restore(&self, py: Python<'_>, settings: &Bound<'_, PyDict>) -> PyResult<()> {
+        let value = crate::json::from_py(settings.as_any())?;
+        if value.get("firmware").and_then(|f| f.as_str()) != Some("v1.0.0") {
+            return Err(PyValueError::new_err(
+                "not v1.0.0 settings: the dict must have \"firmware\": \"v1.0.0\" (as settings() gives)",
+            ));
+        }
+        let part = |key: &str| value.get(key).cloned().unwrap_or(serde_json::Value::Null);
+        let bad = |e: serde_json::Error| PyValueError::new_err(format!("not v1.0.0 settings: {e}"));
+        let all = [
+            p::v1::Settings::System(serde_json::from_value(part("system")).map_err(bad)?),
+            p::v1::Settings::Geometry(serde_json::from_value(part("geometry")).map_err(bad)?),
+            p::v1::Settings::Pid(serde_json::from_value(part("pid")).map_err(bad)?),
+        ];
+        for s in all {
+            self.link.with(py, |d| d.write_settings(s))?;
+        }
+        Ok(())
+    }
+
+    /// The next frame the driver took in (`Telemetry`, or a `ReadbackReply` nobody asked for),
+    /// or `None`.
+    fn poll(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        match self.link.next_event()? {
+            Some(v1::Event::Telemetry(t)) => Ok(Some(
+                frames::Telemetry::from(t)
+                    .into_pyobject(py)?
+                    .into_any()
+                    .unbind(),
+            )),
+            Some(v1::Event::Reply(r)) => Ok(Some(
+                frames::ReadbackReply::from(r)
+                    .into_pyobject(py)?
+                    .into_any()
+                    .unbind(),
+            )),
+            None => Ok(None),
+        }
+    }
+
+    /// Waits up to `timeout` seconds (`None`: for ever) for the next frame.
+    #[pyo3(signature = (timeout = None))]
+    fn wait_frame(&self, py: Python<'_>, timeout: Option<f64>) -> PyResult<Option<Py<PyAny>>> {
+        match wait_event(&self.link, py, timeout)? {
+            Some(v1::Event::Telemetry(t)) => Ok(Some(
+                frames::Telemetry::from(t)
+                    .into_pyobject(py)?
+                    .into_any()
+                    .unbind(),
+            )),
+            Some(v1::Event::Reply(r)) => Ok(Some(
+                frames::ReadbackReply::from(r)
+                    .into_pyobject(py)?
+                    .into_any()
+                    .unbind(),
+            )),
+            None => Ok(None),
+        }
+    }
+
+    fn __iter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    fn __next__(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        match self.wait_frame(py, None) {
+            Err(e) if is_closed(&e, py) => Ok(None),
+            other => other,
+        }
+    }
+
+    /// The latest telemetry frame (or `None`).
+    #[getter]
+    fn telemetry(&self) -> PyResult<Option<frames::Telemetry>> {
+        self.link.core(|c| c.telemetry().map(|s| s.value.into()))
+    }
+
+    /// Whether the board was heard within the failsafe time.
+    #[getter]
+    fn link_alive(&self) -> PyResult<bool> {
+        let now = self.link.now_ms();
+        self.link.core(|c| c.link_alive(now))
+    }
+
+    /// Whether the driver has the chassis moving.
+    #[getter]
+    fn moving(&self) -> PyResult<bool> {
+        self.link.core(v1::DriverCore::moving)
+    }
+
+    /// Times the failsafe has sent the forced stop.
+    #[getter]
+    fn failsafe_stops(&self) -> PyResult<u32> {
+        self.link.core(v1::DriverCore::failsafe_stops)
+    }
+
+    /// The telemetry stream: frames, rate_hz.
+    #[getter]
+    fn streams<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let info = self.link.core(v1::DriverCore::stream)?;
+        let d = PyDict::new(py);
+        d.set_item("telemetry", stream_dict(py, info)?)?;
+        Ok(d)
+    }
+
+    /// The parser's counters (frames, bad_checksum, bad_end, refused, discarded), and frames
+    /// dropped because nobody polled.
+    #[getter]
+    fn counters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = self.link.core(v1::DriverCore::parser_stats)?;
+        let d = PyDict::new(py);
+        d.set_item("frames", s.frames)?;
+        d.set_item("bad_checksum", s.bad_checksum)?;
+        d.set_item("bad_end", s.bad_end)?;
+        d.set_item("refused", s.refused)?;
+        d.set_item("discarded", s.discarded)?;
+        d.set_item("not_polled", self.link.overflowed())?;
+        Ok(d)
+    }
+
+    /// Sends the forced stop and closes the port (again: nothing).
+    fn close(&mut self, py: Python<'_>) -> PyResult<()> {
+        self.link.close(py)
+    }
+
+    fn __enter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    /// Sends the forced stop and closes the port; an exception in the block goes on.
+    fn __exit__(
+        &mut self,
+        py: Python<'_>,
+        _kind: Option<Bound<'_, PyAny>>,
+        value: Option<Bound<'_, PyAny>>,
+        _traceback: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<bool> {
+        let closed = self.link.close(py);
+        if value.is_none() {
+            closed?;
+        }
+        Ok(false)
+    }
+
+    fn __repr__(&self) -> String {
+        format!("ChassisV1(port={:?}, firmware=\"v1.0.0\")", self.link.port)
+    }
+}
