@@ -1,0 +1,54 @@
+"""Shared fixtures: a simulated board of either firmware on a pseudo-terminal (the real OS
+serial stack), and the frames the board must receive, written by hand from the spec's tables."""
+
+from __future__ import annotations
+
+import time
+from typing import Callable, Iterator
+
+import pytest
+
+import chassis
+
+# 2020 firmware, table 1A: velocity mode, X = Y = Z = 0, no direction bits.
+STOP = bytes.fromhex("FF FE 01 00 00 00 00 00 00 00")
+# 1A: Y = 300 (0x012C).
+FORWARD = bytes.fromhex("FF FE 01 00 00 01 2C 00 00 00")
+# 1A, angle mode (dir bit 4): +90.0° (900 = 0x0384).
+TURN_90 = bytes.fromhex("FF FE 01 00 00 00 00 03 84 10")
+# v1.0.0: 0x25 forced stop (ctl 0, all zeros; BCC 7B ^ 25 = 5E).
+FORCED_STOP = bytes.fromhex("7B 25 00 00 00 00 00 00 00 00 00 00 5E 7D")
+# v1.0.0: 0x25, vy = 300 mm/s (01 2C), ctl 2, type 4; BCC 7B^25^02^04^01^2C = 75.
+V1_FORWARD = bytes.fromhex("7B 25 02 04 00 00 01 2C 00 00 00 00 75 7D")
+
+
+@pytest.fixture
+def board() -> Iterator[chassis.sim.Pty]:
+    with chassis.sim.pty() as b:
+        yield b
+
+
+@pytest.fixture
+def v1_board() -> Iterator[chassis.sim.Pty]:
+    with chassis.sim.pty(firmware="v1.0.0") as b:
+        yield b
+
+
+def frames_2020(data: bytes) -> list[bytes]:
+    """The board's received bytes as 10- or 12-byte commands (by the mode byte, from the spec)."""
+    out, at = [], 0
+    while at < len(data):
+        assert data[at : at + 2] == b"\xff\xfe", f"no frame at {at}: {data[at:at + 12].hex(' ')}"
+        length = 12 if data[at + 2] in (0x02, 0x03) else 10
+        out.append(data[at : at + length])
+        at += length
+    return out
+
+
+def wait_until(what: str, condition: Callable[[], bool], seconds: float = 5.0) -> float:
+    """Waits for `condition`; the time it took."""
+    start = time.monotonic()
+    while not condition():
+        assert time.monotonic() - start < seconds, f"never: {what}"
+        time.sleep(0.005)
+    return time.monotonic() - start
