@@ -9,6 +9,7 @@
 //! | `fuzz [SECONDS]` | only the fuzz targets, each for SECONDS (default 30), exploring: random seed, corpora kept |
 //! | `sweep [--seed N]` | the full noise sweep of the downlink parser over every stream model (a few minutes; not part of `test`) |
 //! | `bench [--runs N]` | the parser beside its peers (sbus-rs, uf-crsf, crsf) in one run (or N: the median of each run's ratios): a table with the ratios (not part of `test`, which only builds it) |
+//! | `python` | the Python package built into a virtual environment (`target/python-venv`) as `pip install ./python` builds it, its pytest suite and `mypy --strict` on its examples (part of `test`) |
 //! | `host-demo` | frames built and a noisy board stream parsed, on the host |
 //! | `qemu ELF [--scenario NAME]` | boots a firmware in QEMU against the simulated chassis (the QEMU board's cargo runner) |
 //!
@@ -32,6 +33,7 @@ fn main() -> ExitCode {
         "icount" => firmware::icount(),
         "qemu" => firmware::qemu(&std::env::args().skip(2).collect::<Vec<_>>()),
         "test" => test(),
+        "python" => python(),
         "sweep" => sweep(&std::env::args().skip(2).collect::<Vec<_>>()),
         "bench" => bench(&std::env::args().skip(2).collect::<Vec<_>>()),
         "fuzz" => {
@@ -45,7 +47,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask <demo | test | size | icount | sweep [--seed N] | bench [--runs N] | fuzz [SECONDS] | \
+                "usage: cargo xtask <demo | test | python | size | icount | sweep [--seed N] | bench [--runs N] | fuzz [SECONDS] | \
                  host-demo | qemu FIRMWARE.elf>"
             );
             return ExitCode::from(2);
@@ -390,8 +392,55 @@ fn test() -> Result<(), String> {
         "--no-run",
     ])?;
     msrv()?;
+    python()?;
     firmware::test()?;
     fuzz(FuzzRun::Repeatable)
+}
+
+/// The Python package: built as a user builds it (`pip install ./python`, maturin as the build
+/// backend) into a virtual environment under `target/`, then its tests (pytest, against the
+/// simulated boards on pseudo-terminals) and its examples' types (`mypy --strict`).
+fn python() -> Result<(), String> {
+    let root = workspace_root()?;
+    let venv = root.join("target").join("python-venv");
+    let bin = venv.join("bin");
+    let python = bin.join("python");
+    if !python.is_file() {
+        let venv = venv.to_string_lossy();
+        run(
+            &std::env::var("PYTHON").unwrap_or_else(|_| "python3".into()),
+            &["-m", "venv", &venv],
+        )?;
+    }
+    let python = python.to_string_lossy().into_owned();
+    let package = root.join("python");
+    let package = package.to_string_lossy();
+    let with_tests = format!("{package}[test]");
+    run(
+        &python,
+        &["-m", "pip", "install", "--quiet", "--upgrade", "pip"],
+    )?;
+    run(
+        &python,
+        &[
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--force-reinstall",
+            &with_tests,
+        ],
+    )?;
+    let tests = root.join("python").join("tests");
+    run(&python, &["-m", "pytest", "-q", &tests.to_string_lossy()])?;
+    let examples = root.join("python").join("examples");
+    if examples.is_dir() {
+        run(
+            &python,
+            &["-m", "mypy", "--strict", &examples.to_string_lossy()],
+        )?;
+    }
+    Ok(())
 }
 
 /// The protocol crate, with every feature, builds with the `rust-version` the workspace
