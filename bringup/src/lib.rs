@@ -1,13 +1,21 @@
 //! The chassis bring-up, written once: every board under `boards/` runs [`bring_up`] over its
 //! own UART, through the blocking or the async driver (see [`link`]).
 //!
+//! Two firmware generations, two sequences of the same [`Check`]s (same names, same exit
+//! codes): [`bring_up`] for the 2020 firmware (`FF FE` frames, below), and
+//! [`v1::bring_up_v1`] for v1.0.0 (`7B … BCC 7D` frames: the measured velocity instead of the
+//! encoders, a rotation at a rate instead of the turn by an angle, the forced stop, nothing
+//! written; see [`v1`]). A board that may meet either finds out first with
+//! `chassis_protocol::detect::detect` (the QEMU board does). [`Note`], [`Plan`] and
+//! [`Failure`] are shared; a failure's reason is the generation's ([`Why`], [`v1::WhyV1`]).
+//!
 //! It is written as `async` code and compiled one of two ways: as is (feature `async`, for an
 //! executor such as embassy's), or as plain blocking code (feature `blocking`: the
 //! `maybe-async` macro removes every `async` and `.await`), so that a board without an executor
 //! runs it as ordinary function calls, and its firmware has no future that could be polled
 //! after it finished (a panic path the no-panic proof would find).
 //!
-//! The sequence, each step a named [`Check`]:
+//! The 2020 sequence, each step a named [`Check`]:
 //!
 //! 1. [`Check::Link`]: telemetry arrives; each stream's rate is measured over
 //!    [`Plan::listen_ms`] and must be near its nominal one (IMU 100 Hz, encoders 25 Hz,
@@ -57,6 +65,7 @@ macro_rules! log {
 }
 
 pub mod link;
+pub mod v1;
 
 /// embassy-time as the driver's clock (feature `embassy`).
 #[cfg(feature = "embassy")]
@@ -86,23 +95,25 @@ pub struct Plan {
     pub drive: Option<DriveType>,
     /// Whether the chassis may move. `false`: only [`Check::Link`], [`Check::Settings`] and
     /// [`Check::Battery`] run (nothing is written, nothing moves); the others are skipped.
+    /// Both generations.
     pub motion: bool,
-    /// How long telemetry is listened to before rates are judged, ms (at least 1 s: battery
-    /// frames come at 1 Hz).
+    /// How long telemetry is listened to before rates are judged, ms (at least 1 s: 2020
+    /// battery frames come at 1 Hz). Both generations.
     pub listen_ms: u64,
-    /// Speed of the motion tests (the velocity frame's units).
+    /// Speed of the motion tests (the velocity frame's units: raw on 2020, mm/s on v1.0.0).
     pub speed: i32,
-    /// How long each straight motion lasts, ms.
+    /// How long each straight motion lasts, ms. Both generations.
     pub drive_ms: u64,
     /// The motion commands are re-sent this often, ms (well inside the driver's failsafe).
+    /// Both generations.
     pub command_period_ms: u64,
-    /// The one-shot turn, 0.1°.
+    /// The one-shot turn, 0.1° (2020: v1.0.0 has no turn by an angle).
     pub turn_deci_degrees: i32,
     /// The turn must be done within this, ms.
     pub turn_timeout_ms: u64,
-    /// How long the steady control loop runs, ms.
+    /// How long the steady control loop runs, ms. Both generations.
     pub loop_ms: u64,
-    /// A register read every this many ms during the control loop.
+    /// A register read every this many ms during the control loop (2020).
     pub loop_read_every_ms: u64,
     /// The gyro Z reading (raw counts) a turn must exceed at least once: well above the
     /// sensor's noise at rest.
@@ -110,6 +121,16 @@ pub struct Plan {
     /// Battery voltage below which the bring-up fails when the board uses its built-in table
     /// (0.01 V).
     pub min_centivolts: u16,
+    /// v1.0.0 (which has no turn by an angle): the rate of the rotation check, mrad/s.
+    pub turn_rate_mrad_s: i16,
+    /// v1.0.0: how long the rotation check rotates, ms (its first
+    /// [`v1::RAMP_MS`] are not judged).
+    pub turn_ms: u64,
+    /// v1.0.0: the battery voltage at or below which the bring-up fails, mV.
+    pub min_millivolts: u16,
+    /// v1.0.0: how far a measured velocity, and the yaw turned, may be from what was
+    /// commanded, % of it.
+    pub tolerance_percent: u8,
 }
 
 impl Plan {
@@ -127,6 +148,10 @@ impl Plan {
         loop_read_every_ms: 250,
         gyro_threshold: 20,
         min_centivolts: 1_050,
+        turn_rate_mrad_s: 1_000,
+        turn_ms: 1_200,
+        min_millivolts: 9_000,
+        tolerance_percent: 25,
     };
 }
 
@@ -134,23 +159,26 @@ impl Plan {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Check {
-    /// Telemetry arrives at its rates.
+    /// Telemetry arrives at its rates (v1.0.0: its one frame, at 20–24 Hz).
     Link,
-    /// Every register read.
+    /// Every register read (v1.0.0: the system, geometry and PID readbacks; nothing written).
     Settings,
-    /// The build's drive type is set.
+    /// The build's drive type is set (2020 only: v1.0.0 has no such register).
     DriveType,
-    /// Forward: the encoders count.
+    /// Forward: the encoders count (v1.0.0: the measured velocity follows vy).
     Forward,
-    /// Sideways: the encoders count.
+    /// Sideways: the encoders count (v1.0.0: the measured velocity follows vx).
     Strafe,
-    /// The one-shot turn: the gyro sees it, the pending angle reaches 0.
+    /// The one-shot turn: the gyro sees it, the pending angle reaches 0 (v1.0.0, which has no
+    /// turn by an angle: a rotation at a rate, the quaternion's yaw turns by wz × t).
     Turn,
-    /// After a stop the encoders stand still.
+    /// After a stop the encoders stand still (v1.0.0: after the forced stop, the measured
+    /// velocity is 0).
     Stop,
     /// The battery is above its cut-off.
     Battery,
-    /// The steady control loop: no failsafe stop while reads go on.
+    /// The steady control loop: no failsafe stop while reads go on (v1.0.0: while the
+    /// velocity is re-sent; telemetry keeps coming).
     ControlLoop,
 }
 
@@ -260,14 +288,15 @@ pub enum Why {
     NoEncoderFrames,
 }
 
-/// A failed check and why.
+/// A failed check and why: [`Why`] on the 2020 firmware, [`v1::WhyV1`] on v1.0.0 (the checks
+/// and their exit codes are shared, the reasons are the generation's).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Failure {
+pub struct Failure<W = Why> {
     /// The check that failed.
     pub check: Check,
     /// Why.
-    pub why: Why,
+    pub why: W,
 }
 
 /// What a passed bring-up measured.

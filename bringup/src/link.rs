@@ -4,6 +4,10 @@
 //! `Read + Write + ReadReady`, or embedded-hal-nb serial through `NbSerial`); `Async` (feature
 //! `async`) wraps the async one (embassy's `BufferedUart`). With `blocking`, [`Link`]'s calls
 //! are plain functions and the bring-up is plain blocking code: no executor, no future.
+//!
+//! Both wrappers take the driver's core as a parameter, as the driver does: `Blocking::new`
+//! and `Async::new` make the 2020 driver (a [`Link`]), `Blocking::new_v1` and `Async::new_v1`
+//! the v1.0.0 one (a [`LinkV1`](crate::v1::LinkV1), implemented in [`crate::v1`]).
 
 #[cfg(any(feature = "blocking", feature = "async"))]
 use chassis_protocol::driver::{Clock, CoreError, Outcome, Request};
@@ -16,7 +20,7 @@ use chassis_protocol::{Register, Turn, Velocity, Write};
 pub type LinkError = Error<embedded_io::ErrorKind>;
 
 #[cfg(any(feature = "blocking", feature = "async"))]
-fn kind<E: embedded_io::Error>(e: Error<E>) -> LinkError {
+pub(crate) fn kind<E: embedded_io::Error>(e: Error<E>) -> LinkError {
     e.map_transport(|e| e.kind())
 }
 
@@ -57,11 +61,13 @@ pub trait Link {
 }
 
 /// The blocking driver as a [`Link`] (feature `blocking`; the clock is copied: it must be a
-/// handle, as a SysTick counter or `embassy_time` are).
+/// handle, as a SysTick counter or `embassy_time` are). `K` is the driver's core: the 2020
+/// one by default, [`v1::DriverCore`](chassis_protocol::driver::v1::DriverCore) for a
+/// [`LinkV1`](crate::v1::LinkV1).
 #[cfg(feature = "blocking")]
-pub struct Blocking<U, C> {
-    driver: chassis_protocol::driver::blocking::Driver<U, C>,
-    clock: C,
+pub struct Blocking<U, C, K = DriverCore> {
+    pub(crate) driver: chassis_protocol::driver::blocking::Driver<U, C, K>,
+    pub(crate) clock: C,
 }
 
 #[cfg(feature = "blocking")]
@@ -70,28 +76,46 @@ where
     U: embedded_io::Read + embedded_io::Write + embedded_io::ReadReady,
     C: Clock + Clone,
 {
-    /// Wraps a new blocking driver over `uart`.
+    /// Wraps a new blocking driver for the 2020 firmware over `uart`.
     pub fn new(uart: U, clock: C, config: chassis_protocol::driver::Config) -> Self {
         let driver = chassis_protocol::driver::blocking::Driver::new(uart, clock.clone(), config);
         Blocking { driver, clock }
     }
+}
 
+#[cfg(feature = "blocking")]
+impl<U, C> Blocking<U, C, chassis_protocol::driver::v1::DriverCore>
+where
+    U: embedded_io::Read + embedded_io::Write + embedded_io::ReadReady,
+    C: Clock + Clone,
+{
+    /// Wraps a new blocking driver for the v1.0.0 firmware over `uart` (its failsafe at least
+    /// [`MIN_FAILSAFE_MS`](chassis_protocol::driver::v1::MIN_FAILSAFE_MS)).
+    pub fn new_v1(uart: U, clock: C, config: chassis_protocol::driver::Config) -> Self {
+        let driver =
+            chassis_protocol::driver::blocking::Driver::new_v1(uart, clock.clone(), config);
+        Blocking { driver, clock }
+    }
+}
+
+#[cfg(feature = "blocking")]
+impl<U, C, K> Blocking<U, C, K> {
     /// Wraps a blocking driver already made (opened on a PC's serial port, say); `clock` is
     /// a copy of its clock.
     pub const fn from_driver(
-        driver: chassis_protocol::driver::blocking::Driver<U, C>,
+        driver: chassis_protocol::driver::blocking::Driver<U, C, K>,
         clock: C,
     ) -> Self {
         Blocking { driver, clock }
     }
 
     /// The driver, for what the bring-up does not use.
-    pub fn driver(&mut self) -> &mut chassis_protocol::driver::blocking::Driver<U, C> {
+    pub fn driver(&mut self) -> &mut chassis_protocol::driver::blocking::Driver<U, C, K> {
         &mut self.driver
     }
 
     /// The driver back.
-    pub fn into_driver(self) -> chassis_protocol::driver::blocking::Driver<U, C> {
+    pub fn into_driver(self) -> chassis_protocol::driver::blocking::Driver<U, C, K> {
         self.driver
     }
 }
@@ -142,11 +166,13 @@ where
     }
 }
 
-/// The async driver as a [`Link`] (feature `async`).
+/// The async driver as a [`Link`] (feature `async`). `K` is the driver's core: the 2020 one
+/// by default, [`v1::DriverCore`](chassis_protocol::driver::v1::DriverCore) for a
+/// [`LinkV1`](crate::v1::LinkV1).
 #[cfg(feature = "async")]
-pub struct Async<U, C, D> {
-    driver: chassis_protocol::driver::asynch::Driver<U, C, D>,
-    clock: C,
+pub struct Async<U, C, D, K = DriverCore> {
+    pub(crate) driver: chassis_protocol::driver::asynch::Driver<U, C, D, K>,
+    pub(crate) clock: C,
 }
 
 #[cfg(feature = "async")]
@@ -156,15 +182,33 @@ where
     C: Clock + Clone,
     D: embedded_hal_async::delay::DelayNs,
 {
-    /// Wraps a new async driver over `uart`.
+    /// Wraps a new async driver for the 2020 firmware over `uart`.
     pub fn new(uart: U, clock: C, delay: D, config: chassis_protocol::driver::Config) -> Self {
         let driver =
             chassis_protocol::driver::asynch::Driver::new(uart, clock.clone(), delay, config);
         Async { driver, clock }
     }
+}
 
+#[cfg(feature = "async")]
+impl<U, C, D> Async<U, C, D, chassis_protocol::driver::v1::DriverCore>
+where
+    U: embedded_io_async::Read + embedded_io_async::Write,
+    C: Clock + Clone,
+    D: embedded_hal_async::delay::DelayNs,
+{
+    /// Wraps a new async driver for the v1.0.0 firmware over `uart`.
+    pub fn new_v1(uart: U, clock: C, delay: D, config: chassis_protocol::driver::Config) -> Self {
+        let driver =
+            chassis_protocol::driver::asynch::Driver::new_v1(uart, clock.clone(), delay, config);
+        Async { driver, clock }
+    }
+}
+
+#[cfg(feature = "async")]
+impl<U, C, D, K> Async<U, C, D, K> {
     /// The driver, for what the bring-up does not use.
-    pub fn driver(&mut self) -> &mut chassis_protocol::driver::asynch::Driver<U, C, D> {
+    pub fn driver(&mut self) -> &mut chassis_protocol::driver::asynch::Driver<U, C, D, K> {
         &mut self.driver
     }
 }
