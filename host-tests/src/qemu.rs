@@ -3,8 +3,14 @@
 //! records every frame the firmware sends (with the board's time), applies a [`Scenario`]'s
 //! faults, and returns what happened. Used by `cargo xtask demo`, the board's `cargo run`
 //! runner, and the end-to-end tests (`tests/qemu.rs`).
+//!
+//! The board is either generation ([`Served`]): [`run`]`::<`[`Board`]`>` serves the 2020 board
+//! (`FF FE` frames, what callers get by default through [`Run`]'s and [`Progress`]'s default
+//! type), `run::<`[`v1::Board`]`>` the v1.0.0 one (`7B … BCC 7D`); the firmware finds out which
+//! by itself.
 
-use chassis_protocol::sim::{Board, Faults, SimConfig};
+use chassis_protocol::sim::{Board, Faults, SimConfig, Simulated, v1};
+use chassis_protocol::v1::Parser as _;
 use chassis_protocol::{Command, UplinkParser};
 use std::io::{self, Read, Write};
 use std::net::{TcpListener, TcpStream};
@@ -25,27 +31,95 @@ pub struct Scenario {
     pub silent_after_motion_ms: Option<u64>,
 }
 
-/// A frame the firmware sent, with the board's time when it arrived.
+/// A simulated board the harness serves: the 2020 [`Board`] or the v1.0.0 [`v1::Board`].
+pub trait Served: Simulated + Sized {
+    /// A frame the firmware sends it.
+    type Command: Clone + std::fmt::Debug + PartialEq;
+    /// Its parser of the firmware's bytes.
+    type Parser;
+
+    /// The board just powered up, its noise and faults seeded with `seed`.
+    fn power_up(seed: u64) -> Self;
+    /// Line faults from now on.
+    fn set_faults(&mut self, faults: Faults);
+    /// A parser that has seen nothing.
+    fn parser() -> Self::Parser;
+    /// The frames `bytes` complete, in order.
+    fn parse(parser: &mut Self::Parser, bytes: &[u8]) -> Vec<Self::Command>;
+    /// Whether `command` makes the chassis move.
+    fn moves(command: &Self::Command) -> bool;
+}
+
+impl Served for Board {
+    type Command = Command;
+    type Parser = UplinkParser;
+
+    fn power_up(seed: u64) -> Self {
+        Board::new(SimConfig {
+            seed,
+            ..SimConfig::default()
+        })
+    }
+    fn set_faults(&mut self, faults: Faults) {
+        Board::set_faults(self, faults);
+    }
+    fn parser() -> UplinkParser {
+        UplinkParser::new()
+    }
+    fn parse(parser: &mut UplinkParser, bytes: &[u8]) -> Vec<Command> {
+        parser.frames(bytes).collect()
+    }
+    fn moves(command: &Command) -> bool {
+        is_motion(command)
+    }
+}
+
+impl Served for v1::Board {
+    type Command = chassis_protocol::v1::Command;
+    type Parser = chassis_protocol::v1::UplinkParser;
+
+    fn power_up(seed: u64) -> Self {
+        v1::Board::new(v1::SimConfig {
+            seed,
+            ..v1::SimConfig::default()
+        })
+    }
+    fn set_faults(&mut self, faults: Faults) {
+        v1::Board::set_faults(self, faults);
+    }
+    fn parser() -> Self::Parser {
+        chassis_protocol::v1::UplinkParser::new()
+    }
+    fn parse(parser: &mut Self::Parser, bytes: &[u8]) -> Vec<Self::Command> {
+        parser.frames(bytes).collect()
+    }
+    fn moves(command: &Self::Command) -> bool {
+        is_motion_v1(command)
+    }
+}
+
+/// A frame the firmware sent, with the board's time when it arrived (a 2020 [`Command`] by
+/// default, or a v1.0.0 one).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Sent {
+pub struct Sent<C = Command> {
     /// Board time, ms since the firmware connected.
     pub at_ms: u64,
     /// The frame.
-    pub command: Command,
+    pub command: C,
 }
 
-/// How a run ended.
+/// How a run ended (against the 2020 board by default, or the v1.0.0 one).
 #[derive(Debug)]
-pub struct Run {
+pub struct Run<B: Served = Board> {
     /// QEMU's exit status (the firmware's semihosting exit code); `None` if it was killed at
     /// the time limit.
     pub status: Option<ExitStatus>,
     /// Everything the firmware sent, in order.
-    pub sent: Vec<Sent>,
+    pub sent: Vec<Sent<B::Command>>,
     /// When the board went silent (board time, ms), if it did.
     pub silenced_at_ms: Option<u64>,
-    /// The board at the end (registers, motion, turns commanded).
-    pub board: Board,
+    /// The board at the end (registers or settings, motion, what it received).
+    pub board: B,
     /// What the board sent, as written to the link: (board time in ms, bytes).
     pub downlink: Vec<(u64, Vec<u8>)>,
     /// The firmware's raw stdout (defmt frames over semihosting).
@@ -54,7 +128,7 @@ pub struct Run {
     pub elapsed: Duration,
 }
 
-impl Run {
+impl<B: Served> Run<B> {
     /// The exit code, if QEMU exited by itself.
     pub fn exit_code(&self) -> Option<i32> {
         self.status.and_then(|s| s.code())
@@ -85,27 +159,28 @@ impl Emulator {
 
 /// What the run reports while it goes (for a live view): called about every 250 ms.
 #[derive(Clone, Copy, Debug)]
-pub struct Progress<'a> {
+pub struct Progress<'a, B: Served = Board> {
     /// Board time, ms.
     pub now_ms: u64,
     /// The board.
-    pub board: &'a Board,
+    pub board: &'a B,
     /// Frames the firmware sent so far.
     pub sent: usize,
     /// The last frame it sent.
-    pub last: Option<&'a Sent>,
+    pub last: Option<&'a Sent<B::Command>>,
 }
 
-/// Boots `elf` in the emulator against a simulated board, until the firmware exits or the
-/// limit passes. `on_log` gets the firmware's stdout as it comes (e.g. to pipe it to
-/// `defmt-print`), `on_progress` the board's state about four times a second.
-pub fn run(
+/// Boots `elf` in the emulator against a simulated board `B` (the 2020 [`Board`] or the
+/// v1.0.0 [`v1::Board`]), until the firmware exits or the limit passes. `on_log` gets the
+/// firmware's stdout as it comes (e.g. to pipe it to `defmt-print`), `on_progress` the board's
+/// state about four times a second.
+pub fn run<B: Served>(
     emulator: &Emulator,
     elf: &Path,
     scenario: &Scenario,
     mut on_log: impl FnMut(&[u8]),
-    mut on_progress: impl FnMut(Progress<'_>),
-) -> io::Result<Run> {
+    mut on_progress: impl FnMut(Progress<'_, B>),
+) -> io::Result<Run<B>> {
     let listener = TcpListener::bind("127.0.0.1:0")?;
     let port = listener.local_addr()?.port();
     let started = Instant::now();
@@ -141,14 +216,11 @@ pub fn run(
     stream.set_nonblocking(true)?;
     let mut io = stream;
 
-    let mut board = Board::new(SimConfig {
-        seed: scenario.seed,
-        ..SimConfig::default()
-    });
+    let mut board = B::power_up(scenario.seed);
     board.set_faults(scenario.faults);
     let connected = Instant::now();
-    let mut parser = UplinkParser::new();
-    let mut sent: Vec<Sent> = Vec::new();
+    let mut parser = B::parser();
+    let mut sent: Vec<Sent<B::Command>> = Vec::new();
     let mut log = Vec::new();
     let mut downlink = Vec::new();
     let mut silenced_at_ms = None;
@@ -178,8 +250,8 @@ pub fn run(
             Ok(n) => {
                 let bytes = &buf[..n];
                 board.receive(bytes);
-                for command in parser.frames(bytes) {
-                    if first_motion_ms.is_none() && is_motion(&command) {
+                for command in B::parse(&mut parser, bytes) {
+                    if first_motion_ms.is_none() && B::moves(&command) {
                         first_motion_ms = Some(now_ms);
                     }
                     sent.push(Sent {
@@ -307,6 +379,19 @@ pub fn is_motion(command: &Command) -> bool {
         Command::Velocity(v) => v.x != 0 || v.y != 0 || v.z != 0,
         Command::Turn(_) | Command::Motors(_) => true,
         Command::Setting(_) => false,
+    }
+}
+
+/// A v1.0.0 frame that makes the chassis move: a body or per-motor velocity that drives
+/// (`ctl` 2) at something other than zero. The forced stop does not.
+pub fn is_motion_v1(command: &chassis_protocol::v1::Command) -> bool {
+    use chassis_protocol::v1::{BodyVelocity, Command as V1};
+    match command {
+        V1::BodyVelocity(v) => {
+            v.ctl == BodyVelocity::DRIVE && (v.vx_mm_s != 0 || v.vy_mm_s != 0 || v.wz_mrad_s != 0)
+        }
+        V1::MotorVelocity(m) => m.ctl == BodyVelocity::DRIVE && m.speeds != [0; 4],
+        _ => false,
     }
 }
 
