@@ -320,8 +320,10 @@ const PROBES: [&str; 5] = [
 
 /// The budgets of the firmware issue, in bytes.
 pub mod budget {
-    /// The whole QEMU bring-up firmware's flash.
-    pub const FIRMWARE_FLASH: u64 = 32 * 1024;
+    /// The whole QEMU bring-up firmware's flash. 32 KiB while it ran the 2020 bring-up alone
+    /// (30 872 B); raised to 46 KiB when it learnt to detect the generation and run the v1.0.0
+    /// bring-up too (45 476 B: detection, the v1.0.0 driver and parser, the v1.0.0 checks).
+    pub const FIRMWARE_FLASH: u64 = 46 * 1024;
     /// The whole QEMU bring-up firmware's RAM (static here; the stack peak is checked by the
     /// end-to-end test, which reads it from the firmware's log).
     pub const FIRMWARE_RAM: u64 = 8 * 1024;
@@ -377,8 +379,10 @@ pub fn size_table() -> Result<bool, String> {
     let qemu = firmware[0];
     let fw_ok = qemu.flash <= budget::FIRMWARE_FLASH && qemu.ram <= budget::FIRMWARE_RAM;
     println!(
-        "\nQEMU firmware against its budget (32 KiB flash, 8 KiB RAM; its stack peak is measured \
+        "\nQEMU firmware against its budget ({} KiB flash, {} KiB RAM; its stack peak is measured \
          in the end-to-end test): {}",
+        budget::FIRMWARE_FLASH / 1024,
+        budget::FIRMWARE_RAM / 1024,
         if fw_ok { "met" } else { "NOT MET" }
     );
     println!(

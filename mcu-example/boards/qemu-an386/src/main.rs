@@ -2,13 +2,27 @@
 //! (the simulated one, over TCP), defmt goes out over semihosting, and the exit status is the
 //! verdict: 0 when every check passed, else [`Check::exit_code`] of the one that failed.
 //!
+//! It first finds which firmware the board runs (`chassis_protocol::detect::detect`: it
+//! listens, and probes only a quiet line), logs it, then runs that generation's bring-up:
+//!
+//! * **2020** (`FF FE` frames): [`bring_up`] over the 2020 blocking driver (the encoders count,
+//!   one 90° turn sent once, the drive type, register reads while moving).
+//! * **v1.0.0** (`7B … BCC 7D` frames): [`bring_up_v1`] over the v1.0.0 blocking driver (the
+//!   measured velocity follows, a rotation at a rate turns the quaternion's yaw, the forced
+//!   stop; nothing written).
+//!
+//! A silent line is taken as 2020, whose link check then fails (exit 10) saying what did not
+//! come; bytes of neither generation fail the link check at once, with nothing sent.
+//!
 //! Run it with `cargo xtask demo` from the repository root, or `cargo run --release` here.
 
 #![no_std]
 #![no_main]
 
-use board_qemu_an386::{stack, time};
-use chassis_bringup::{Plan, Report, bring_up, link::Blocking};
+use board_qemu_an386::{stack, time, uart::Uart0};
+use chassis_bringup::v1::{ReportV1, bring_up_v1};
+use chassis_bringup::{Check, Plan, Report, bring_up, link::Blocking};
+use chassis_protocol::detect::{Firmware, detect};
 use chassis_protocol::driver::Config;
 use cortex_m_rt::entry;
 #[cfg(feature = "log")]
@@ -18,30 +32,28 @@ use defmt_semihosting as _;
 /// emulated UART is fed by another process over TCP, which hands bytes over in bursts when the
 /// host is busy; a gap of a few ms inside a frame there is the host, not the board, and a quiet
 /// line taken for a frame boundary would throw a frame away. 10 ms is longer than those gaps
-/// and still far shorter than the failsafe (100 ms).
+/// and still far shorter than the failsafe (100 ms on 2020; the v1.0.0 driver raises it to
+/// 300 ms). Detection uses the same quiet line.
 const CONFIG: Config = Config {
     idle_ms: 10,
     ..Config::DEFAULT
 };
 
+/// Detection is tried again this many times in all if the UART fails (a receive overrun).
+const DETECT_TRIES: u8 = 3;
+
 #[entry]
 fn main() -> ! {
     stack::paint();
-    let uart = board_qemu_an386::init();
+    let mut uart = board_qemu_an386::init();
     defmt::info!(
         "chassis bring-up: QEMU mps2-an386, Cortex-M4, UART0 at 115200 bps, blocking driver"
     );
 
-    let mut link = Blocking::new(uart, time::Millis, CONFIG);
-    let code = match bring_up(&mut link, &Plan::DEFAULT) {
-        Ok(report) => {
-            log_report(&report);
-            0
-        }
-        Err(failure) => {
-            defmt::error!("FAIL: {} ({})", failure.check, failure.why);
-            failure.check.exit_code()
-        }
+    let code = match firmware(&mut uart) {
+        Ok(Firmware::V1_0_0) => v1_0_0(uart),
+        Ok(Firmware::V2020) => v2020(uart),
+        Err(code) => code,
     };
     defmt::info!(
         "RAM: {} B static + {} B stack at its peak",
@@ -51,8 +63,84 @@ fn main() -> ! {
     semihosting::process::exit(code)
 }
 
+/// Which firmware the board runs (a silent line: 2020), or the exit code of a line that
+/// carries neither.
+fn firmware(uart: &mut Uart0) -> Result<Firmware, i32> {
+    let mut tries = 0u8;
+    let detection = loop {
+        tries = tries.saturating_add(1);
+        match detect(uart, &mut time::Millis, &CONFIG) {
+            Ok(detection) => break detection,
+            Err(e) if tries < DETECT_TRIES => defmt::warn!("detect: {}; again", e),
+            Err(e) => {
+                defmt::error!("FAIL: detect: {}", e);
+                return Err(Check::Link.exit_code());
+            }
+        }
+    };
+    match detection.firmware {
+        Some(firmware) => {
+            defmt::info!(
+                "firmware {} ({}): {}",
+                firmware.name(),
+                firmware.framing(),
+                detection
+            );
+            Ok(firmware)
+        }
+        None if detection.heard.bytes == 0 => {
+            defmt::warn!(
+                "firmware: the line is silent ({}): taken as 2020, whose link check says the rest",
+                detection
+            );
+            Ok(Firmware::V2020)
+        }
+        None => {
+            defmt::error!(
+                "FAIL: bytes of neither firmware ({}): another device, or another baud rate?",
+                detection
+            );
+            Err(Check::Link.exit_code())
+        }
+    }
+}
+
+/// The 2020 bring-up; its exit code.
+fn v2020(uart: Uart0) -> i32 {
+    let mut link = Blocking::new(uart, time::Millis, CONFIG);
+    match bring_up(&mut link, &Plan::DEFAULT) {
+        Ok(report) => {
+            log_report(&report);
+            0
+        }
+        Err(failure) => {
+            defmt::error!("FAIL: {} ({})", failure.check, failure.why);
+            failure.check.exit_code()
+        }
+    }
+}
+
+/// The v1.0.0 bring-up; its exit code.
+fn v1_0_0(uart: Uart0) -> i32 {
+    let mut link = Blocking::new_v1(uart, time::Millis, CONFIG);
+    match bring_up_v1(&mut link, &Plan::DEFAULT) {
+        Ok(report) => {
+            log_report_v1(&report);
+            0
+        }
+        Err(failure) => {
+            defmt::error!("FAIL: {} ({})", failure.check, failure.why);
+            failure.check.exit_code()
+        }
+    }
+}
+
 fn log_report(report: &Report) {
     defmt::info!("PASS: every check passed: {}", report);
+}
+
+fn log_report_v1(report: &ReportV1) {
+    defmt::info!("PASS: every check passed (v1.0.0): {}", report);
 }
 
 #[cfg(not(feature = "no-panic-proof"))]
