@@ -1,14 +1,19 @@
 //! End to end: the bring-up firmware in QEMU (mps2-an386, Cortex-M4) against the simulated
 //! chassis over TCP. Each test asserts on what the chassis received and on the firmware's exit
-//! status.
+//! status. The firmware detects the board's generation first: most tests serve the 2020 board,
+//! the `v1_` ones the v1.0.0 board (`7B … BCC 7D`), and the same ELF runs that generation's
+//! bring-up.
 //!
 //! They need the firmware built and `qemu-system-arm`, so they are `#[ignore]`d in a plain
 //! `cargo test`; `cargo xtask test` builds the firmware and runs them with `--ignored`, the
 //! firmware's path in `CHASSIS_FIRMWARE`.
 
-use chassis_host_tests::qemu::{self, Emulator, Run, Scenario, Sent, is_motion};
+use chassis_host_tests::qemu::{
+    self, Emulator, Run, Scenario, Sent, Served, is_motion, is_motion_v1,
+};
 use chassis_protocol::driver::Config;
-use chassis_protocol::sim::Faults;
+use chassis_protocol::sim::{Faults, v1};
+use chassis_protocol::v1::{BodyVelocity, Command as V1Command};
 use chassis_protocol::{Command, Register, Setting, Snapshot, Velocity};
 use std::path::PathBuf;
 use std::sync::OnceLock;
@@ -17,6 +22,17 @@ use std::sync::OnceLock;
 const SETTINGS: i32 = 11;
 const FORWARD: i32 = 13;
 const STRAFE: i32 = 14;
+const CONTROL_LOOP: i32 = 18;
+
+/// The v1.0.0 forced stop, by hand from PROTOCOL-V1.md: `7B`, code `25`, ten `00` (`ctl` 0,
+/// type 0, vx vy wz 0, `00 00`), BCC `7B ^ 25 = 5E`, `7D`.
+const FORCED_STOP: [u8; 14] = [
+    0x7B, 0x25, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x5E, 0x7D,
+];
+
+/// The v1.0.0 driver's failsafe (`chassis_protocol::driver::v1::MIN_FAILSAFE_MS`: the QEMU
+/// firmware's 100 ms is raised to it).
+const V1_FAILSAFE_MS: u64 = 300;
 
 fn firmware() -> PathBuf {
     let path = std::env::var_os("CHASSIS_FIRMWARE")
@@ -27,6 +43,11 @@ fn firmware() -> PathBuf {
 }
 
 fn boot(scenario: Scenario) -> Run {
+    boot_on(scenario)
+}
+
+/// Boots the firmware against a simulated board of generation `B`.
+fn boot_on<B: Served>(scenario: Scenario) -> Run<B> {
     let run = qemu::run(
         &Emulator::mps2_an386(),
         &firmware(),
@@ -277,4 +298,171 @@ fn a_line_with_one_error_in_a_thousand_bytes_still_brings_up() {
         assert_eq!(turns, 1, "seed {seed}: one turn");
         assert_eq!(run.board.total_turn_commanded(), 900, "seed {seed}");
     }
+}
+
+/// The bring-up against the v1.0.0 board, run once for the tests that look at it.
+fn normal_v1() -> &'static Run<v1::Board> {
+    static RUN: OnceLock<Run<v1::Board>> = OnceLock::new();
+    RUN.get_or_init(|| boot_on(Scenario::default()))
+}
+
+/// The frames that set the chassis moving or stop it (`0x25`, `0x26`).
+fn motion_frames(sent: &[Sent<V1Command>]) -> impl Iterator<Item = &Sent<V1Command>> {
+    sent.iter().filter(|s| {
+        matches!(
+            s.command,
+            V1Command::BodyVelocity(_) | V1Command::MotorVelocity(_)
+        )
+    })
+}
+
+#[test]
+#[ignore = "needs the firmware and qemu-system-arm: cargo xtask test"]
+fn v1_board_bring_up_passes_and_ends_with_the_forced_stop() {
+    let run = normal_v1();
+    if run.exit_code() != Some(0) {
+        let log = qemu::decode_log(&firmware(), &run.log).unwrap_or_default();
+        panic!("every check passes, not {:?}:\n{log}", run.exit_code());
+    }
+    let stats = run.board.uplink_stats();
+    assert_eq!(
+        (
+            stats.discarded,
+            stats.bad_checksum,
+            stats.bad_end,
+            stats.refused
+        ),
+        (0, 0, 0, 0),
+        "the board received only whole v1.0.0 frames: {stats:?}"
+    );
+    assert_eq!(
+        run.board.total_commands() as usize,
+        run.sent.len(),
+        "every frame the firmware sent was taken"
+    );
+    for code in [0x23, 0x24, 0x40] {
+        assert_eq!(
+            run.board.received_count(code),
+            0,
+            "no settings frame {code:#04x}: nothing is written unasked"
+        );
+    }
+    assert!(!run.sent.iter().any(|s| matches!(
+        s.command,
+        V1Command::System(_) | V1Command::Geometry(_) | V1Command::Pid(_)
+    )));
+    for code in [0x33, 0x34, 0x50] {
+        assert!(
+            run.board.received_count(code) >= 1,
+            "the readback {code:#04x} was sent"
+        );
+    }
+    let last = motion_frames(&run.sent)
+        .last()
+        .expect("motion frames were sent");
+    assert_eq!(
+        last.command.encode(),
+        FORCED_STOP,
+        "the last motion frame is the forced stop"
+    );
+    assert_eq!(
+        run.board.velocity(),
+        BodyVelocity::FORCED_STOP,
+        "the board was left with the forced stop"
+    );
+    assert_eq!(run.board.measured_velocity(), [0, 0, 0], "and stands still");
+    // While the chassis moves, its velocity is re-sent well inside the failsafe.
+    let moving: Vec<&Sent<V1Command>> = motion_frames(&run.sent).collect();
+    let longest = moving
+        .windows(2)
+        .filter(|w| is_motion_v1(&w[0].command))
+        .map(|w| w[1].at_ms - w[0].at_ms)
+        .max()
+        .unwrap_or(0);
+    assert!(
+        longest < V1_FAILSAFE_MS / 2,
+        "motion re-sent every period: longest gap {longest} ms"
+    );
+}
+
+#[test]
+#[ignore = "needs the firmware and qemu-system-arm: cargo xtask test"]
+fn v1_log_names_the_firmware_and_every_check_and_the_ram_fits() {
+    let run = normal_v1();
+    let log = qemu::decode_log(&firmware(), &run.log).expect("defmt-print decodes the log");
+    for step in [
+        "firmware v1.0.0",
+        "[link] up",
+        "[settings] SystemSettings",
+        "[settings] Geometry",
+        "[settings] Pid",
+        "[Forward] commanded 300 mm/s",
+        "[Strafe] commanded 300 mm/s",
+        "[turn] rotated at 1000 mrad/s",
+        "[stop] forced stop: still",
+        "[battery]",
+        "[control-loop]",
+        "PASS: every check passed (v1.0.0)",
+    ] {
+        assert!(log.contains(step), "the log has {step:?}:\n{log}");
+    }
+    assert!(!log.contains("[drive-type]"), "no drive type on v1.0.0");
+    let line = log
+        .lines()
+        .find(|l| l.contains("RAM: "))
+        .expect("the firmware reports its RAM");
+    let numbers: Vec<usize> = line
+        .split_whitespace()
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    let [static_ram, stack] = numbers[..] else {
+        panic!("unexpected RAM line {line:?}");
+    };
+    eprintln!("RAM on v1.0.0: {static_ram} B static + {stack} B stack");
+    assert!(
+        static_ram + stack <= 8 * 1024,
+        "the firmware fits 8 KiB of RAM: {static_ram} + {stack}"
+    );
+}
+
+#[test]
+#[ignore = "needs the firmware and qemu-system-arm: cargo xtask test"]
+fn v1_board_going_silent_in_the_control_loop_gets_the_failsafe_forced_stop() {
+    // From the first motion: forward 0.4 s, sideways 0.4 s, the rotation 1.2 s, the stop
+    // 0.5 s, then the control loop for 1.5 s: 3 s in is the middle of the loop.
+    let run: Run<v1::Board> = boot_on(Scenario {
+        silent_after_motion_ms: Some(3_000),
+        ..Scenario::default()
+    });
+    let log = qemu::decode_log(&firmware(), &run.log).unwrap_or_default();
+    assert_eq!(
+        run.exit_code(),
+        Some(CONTROL_LOOP),
+        "the control loop fails:\n{log}"
+    );
+    assert!(
+        log.contains("ControlLoop failed") && log.contains("FailsafeStop"),
+        "the failsafe stopped it:\n{log}"
+    );
+    let silent = run.silenced_at_ms.expect("the board went silent");
+    let stop = run
+        .sent
+        .iter()
+        .find(|s| s.at_ms >= silent && s.command.encode() == FORCED_STOP)
+        .expect("the forced stop was sent after the silence");
+    let after = stop.at_ms - silent;
+    eprintln!("silent at {silent} ms, forced stop {after} ms later");
+    // The failsafe (the log says it was the failsafe) counts from the last frame heard, before
+    // the silence; plus the emulator's and the host's latency.
+    assert!(
+        after <= V1_FAILSAFE_MS + 60,
+        "stopped {after} ms after the board went silent"
+    );
+    assert!(
+        !run.sent
+            .iter()
+            .any(|s| s.at_ms > stop.at_ms && is_motion_v1(&s.command)),
+        "nothing moves the chassis after the failsafe's forced stop"
+    );
+    assert_eq!(run.board.velocity(), BodyVelocity::FORCED_STOP);
 }
