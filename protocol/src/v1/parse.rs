@@ -23,6 +23,18 @@ pub struct Stats {
     pub discarded: u32,
 }
 
+/// Moves `buf[from..len]` to the front, byte by byte: no `memmove` and no panic path (a
+/// firmware's link-time no-panic proof must see none).
+fn shift_down<const N: usize>(buf: &mut [u8; N], from: usize, len: usize) {
+    for (to, at) in (from..len.min(N)).enumerate() {
+        if let Some(byte) = buf.get(at).copied() {
+            if let Some(slot) = buf.get_mut(to) {
+                *slot = byte;
+            }
+        }
+    }
+}
+
 /// The bytes of at most one frame, and the rules to find one.
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -50,7 +62,7 @@ impl<const N: usize> Framer<N> {
     /// Drops the first `n` held bytes.
     fn drop_front(&mut self, n: usize) {
         let n = n.min(self.len);
-        self.buf.copy_within(n..self.len, 0);
+        shift_down(&mut self.buf, n, self.len);
         self.len = self.len.saturating_sub(n);
         self.stats.discarded = self
             .stats
@@ -117,7 +129,7 @@ impl<const N: usize> Framer<N> {
     /// Forgets the `n` bytes of a frame taken (not counted as discarded).
     fn consume(&mut self, n: usize) {
         let n = n.min(self.len);
-        self.buf.copy_within(n..self.len, 0);
+        shift_down(&mut self.buf, n, self.len);
         self.len = self.len.saturating_sub(n);
     }
 }
