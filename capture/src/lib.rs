@@ -939,7 +939,9 @@ fn describe_v1_downlink(frame: &v1::Downlink) -> (Value, String) {
 }
 
 /// A master → board v1.0.0 frame as JSON and one line of text.
-fn describe_v1_uplink(command: &v1::Command) -> (Value, String) {
+/// A v1.0.0 command as its JSON object (the `"frame"` kind and its fields) and a line of
+/// text, as `chassis decode` prints it.
+pub fn describe_v1_uplink(command: &v1::Command) -> (Value, String) {
     let (kind, fields, text) = match command {
         v1::Command::BodyVelocity(v) if v.is_forced_stop() => {
             let (mut fields, _) = body_velocity(v);

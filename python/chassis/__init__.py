@@ -6,7 +6,7 @@ of both firmware generations (2020: ``FF FE`` frames; v1.0.0: ``7B … BCC 7D``)
 boards to try it all without hardware.
 
 >>> import chassis
->>> with chassis.sim.pty() as board, chassis.open(board.path) as bot:
+>>> with chassis.sim.pty() as board, chassis.open(board.path, firmware="2020") as bot:
 ...     bot.read("motor-voltage")
 1200
 
@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import atexit
 import weakref
-from typing import Optional, Union
+from typing import Literal, Optional, Union, overload
 
 from . import sim
 from .chassis_native import (
@@ -92,6 +92,42 @@ __all__ = [
 
 # Every chassis still open when the interpreter exits is stopped and closed.
 _open_chassis: "weakref.WeakSet[Union[Chassis, ChassisV1]]" = weakref.WeakSet()
+
+
+@overload
+def open(
+    port: str,
+    *,
+    firmware: Literal["2020"],
+    failsafe_ms: Optional[int] = None,
+    board_latency_ms: Optional[int] = None,
+    idle_ms: Optional[int] = None,
+    read_tries: Optional[int] = None,
+) -> Chassis: ...
+
+
+@overload
+def open(
+    port: str,
+    *,
+    firmware: Literal["v1.0.0", "v1"],
+    failsafe_ms: Optional[int] = None,
+    board_latency_ms: Optional[int] = None,
+    idle_ms: Optional[int] = None,
+    read_tries: Optional[int] = None,
+) -> ChassisV1: ...
+
+
+@overload
+def open(
+    port: str,
+    *,
+    firmware: Optional[str] = None,
+    failsafe_ms: Optional[int] = None,
+    board_latency_ms: Optional[int] = None,
+    idle_ms: Optional[int] = None,
+    read_tries: Optional[int] = None,
+) -> Union[Chassis, ChassisV1]: ...
 
 
 def open(

@@ -64,10 +64,10 @@ fn input_of(name: &str) -> PyResult<decode::Input> {
 #[pyo3(signature = (data, *, input = "raw", uplink = false, master = None, firmware = None, quiet_ms = None))]
 pub fn decode_capture(
     py: Python<'_>,
-    data: &[u8],
+    data: pyo3::pybacked::PyBackedBytes,
     input: &str,
     uplink: bool,
-    master: Option<&[u8]>,
+    master: Option<pyo3::pybacked::PyBackedBytes>,
     firmware: Option<&str>,
     quiet_ms: Option<f64>,
 ) -> PyResult<Decoded> {
@@ -91,9 +91,9 @@ pub fn decode_capture(
     }
     let quiet_s = quiet_ms.map(|q| q / 1000.0);
     let decoded = py.detach(|| -> Result<decode::Decoded, String> {
-        let mut capture = decode::read_capture(data, input)?;
+        let mut capture = decode::read_capture(&data, input)?;
         capture.quiet_s = quiet_s;
-        match master {
+        match master.as_deref() {
             Some(m) => {
                 let mut master = decode::read_capture(m, input)?;
                 master.quiet_s = quiet_s;

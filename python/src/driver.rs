@@ -26,8 +26,10 @@ use std::time::{Duration, Instant};
 /// driver): 1 024 frames are 8 s of the 2020 board's telemetry.
 const QUEUE: usize = 1_024;
 
-/// How often the pump thread takes in what arrived and judges time (the failsafe).
-const PUMP_EVERY: Duration = Duration::from_millis(2);
+/// How often the pump thread takes in what arrived and judges time (the failsafe): every
+/// 10 ms, or sooner when the driver has a deadline (a reply, the failsafe) before then. Frames
+/// reach `poll()` at most this late; the failsafe is judged on time.
+const PUMP_EVERY: Duration = Duration::from_millis(10);
 
 /// What the pump thread and the Python calls share.
 struct State<K: Core> {
@@ -97,7 +99,7 @@ where
             let running = Arc::clone(&running);
             std::thread::Builder::new()
                 .name("chassis-pump".into())
-                .spawn(move || pump(&state, &running))
+                .spawn(move || pump(&state, &running, clock))
                 .ok()
         };
         Link {
@@ -196,8 +198,10 @@ impl<K: Core> Drop for Link<K> {
 }
 
 /// The pump thread: takes in what arrived and judges time, every [`PUMP_EVERY`].
-fn pump<K: Core>(state: &Mutex<State<K>>, running: &AtomicBool) {
+fn pump<K: Core>(state: &Mutex<State<K>>, running: &AtomicBool, clock: MonotonicClock) {
+    use chassis_protocol::driver::Clock as _;
     while running.load(Ordering::SeqCst) {
+        let mut nap = PUMP_EVERY;
         {
             let mut guard = lock(state);
             let st = &mut *guard;
@@ -223,8 +227,12 @@ fn pump<K: Core>(state: &Mutex<State<K>>, running: &AtomicBool) {
                     }
                 }
             }
+            let mut now = clock;
+            if let Some(ms) = driver.core().wait_ms(now.now_ms()) {
+                nap = nap.min(Duration::from_millis(ms.max(1)));
+            }
         }
-        std::thread::sleep(PUMP_EVERY);
+        std::thread::sleep(nap);
     }
 }
 
@@ -591,19 +599,27 @@ impl Chassis {
         Ok(differs)
     }
 
-    /// The next frame the driver took in (`Imu`, `Encoders`, `Battery`, `Reply`), or `None`.
+    /// The next telemetry frame the driver took in (`Imu`, `Encoders`, `Battery`), or `None`
+    /// when none is waiting. Never blocks.
     fn poll(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
-        match self.link.next_event()? {
-            Some(Event::Telemetry(f)) => Ok(Some(frames::downlink(py, f)?)),
-            Some(_) | None => Ok(None),
+        loop {
+            match self.link.next_event()? {
+                Some(Event::Telemetry(f)) => return Ok(Some(frames::downlink(py, f)?)),
+                // Replies are the driver's (its reads): not telemetry.
+                Some(_) => continue,
+                None => return Ok(None),
+            }
         }
     }
 
-    /// Waits up to `timeout` seconds (`None`: for ever) for the next frame.
+    /// Waits up to `timeout` seconds (`None`: for ever) for the next telemetry frame; `None`
+    /// if none came.
     #[pyo3(signature = (timeout = None))]
     fn wait_frame(&self, py: Python<'_>, timeout: Option<f64>) -> PyResult<Option<Py<PyAny>>> {
+        let end = timeout.map(|t| Instant::now() + Duration::from_secs_f64(t.max(0.0)));
         loop {
-            match wait_event(&self.link, py, timeout)? {
+            let left = end.map(|end| end.saturating_duration_since(Instant::now()).as_secs_f64());
+            match wait_event(&self.link, py, left)? {
                 Some(Event::Telemetry(f)) => return Ok(Some(frames::downlink(py, f)?)),
                 Some(_) => continue,
                 None => return Ok(None),
@@ -611,10 +627,13 @@ impl Chassis {
         }
     }
 
+    /// Iterating a chassis yields its telemetry frames as they come (blocking; Ctrl-C raises
+    /// `KeyboardInterrupt`); it ends when the chassis is closed.
     fn __iter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
         slf
     }
 
+    /// The next telemetry frame (waits for it).
     fn __next__(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
         match self.wait_frame(py, None) {
             Err(e) if is_closed(&e, py) => Ok(None),
@@ -698,12 +717,13 @@ impl Chassis {
     fn __exit__(
         &mut self,
         py: Python<'_>,
-        _kind: Option<Bound<'_, PyAny>>,
-        value: Option<Bound<'_, PyAny>>,
-        _traceback: Option<Bound<'_, PyAny>>,
+        exc_type: Option<Bound<'_, PyAny>>,
+        exc_value: Option<Bound<'_, PyAny>>,
+        traceback: Option<Bound<'_, PyAny>>,
     ) -> PyResult<bool> {
+        let _ = (exc_type, traceback);
         let closed = self.link.close(py);
-        if value.is_none() {
+        if exc_value.is_none() {
             closed?;
         }
         Ok(false)
@@ -715,8 +735,8 @@ impl Chassis {
 }
 
 /// The system-mode register (0x09), by field.
-#[pyclass(module = "chassis", frozen, eq, from_py_object)]
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[pyclass(module = "chassis", frozen, eq, hash, from_py_object)]
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
 pub struct SystemMode {
     /// The raw bits.
     #[pyo3(get)]
@@ -978,10 +998,13 @@ impl ChassisV1 {
         }
     }
 
+    /// Iterating a chassis yields its frames as they come (blocking; Ctrl-C raises
+    /// `KeyboardInterrupt`); it ends when the chassis is closed.
     fn __iter__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
         slf
     }
 
+    /// The next frame (waits for it).
     fn __next__(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
         match self.wait_frame(py, None) {
             Err(e) if is_closed(&e, py) => Ok(None),
@@ -1051,12 +1074,13 @@ impl ChassisV1 {
     fn __exit__(
         &mut self,
         py: Python<'_>,
-        _kind: Option<Bound<'_, PyAny>>,
-        value: Option<Bound<'_, PyAny>>,
-        _traceback: Option<Bound<'_, PyAny>>,
+        exc_type: Option<Bound<'_, PyAny>>,
+        exc_value: Option<Bound<'_, PyAny>>,
+        traceback: Option<Bound<'_, PyAny>>,
     ) -> PyResult<bool> {
+        let _ = (exc_type, traceback);
         let closed = self.link.close(py);
-        if value.is_none() {
+        if exc_value.is_none() {
             closed?;
         }
         Ok(false)

@@ -320,7 +320,8 @@ pub struct Imu {
 #[pyclass(module = "chassis", frozen, eq, hash, from_py_object)]
 #[derive(Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Encoders {
-    /// Ticks of MOTO1..MOTO4 in the last period.
+    /// MOTO1..MOTO4 as the board sends them (whether a count per period or a running total
+    /// is not stated: spec A5).
     #[pyo3(get)]
     pub ticks: [i16; 4],
     /// Rolling count.
@@ -359,9 +360,11 @@ pub struct Reply {
 }
 
 macro_rules! downlink_methods {
-    ($ty:ident, $inner:path, $repr:expr) => {
+    ($ty:ident, $inner:path, $repr:expr, { $($new:tt)* }) => {
         #[pymethods]
         impl $ty {
+            $($new)*
+
             /// The frame's bytes.
             fn encode<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
                 PyBytes::new(py, &self.inner().encode())
@@ -399,10 +402,18 @@ impl From<p::Imu> for Imu {
         }
     }
 }
-downlink_methods!(Imu, p::Imu, |f| format!(
-    "Imu(accel={:?}, gyro={:?}, seq={})",
-    f.accel, f.gyro, f.seq
-));
+downlink_methods!(
+    Imu,
+    p::Imu,
+    |f| format!("Imu(accel={:?}, gyro={:?}, seq={})", f.accel, f.gyro, f.seq),
+    {
+        #[new]
+        #[pyo3(signature = (accel, gyro, seq))]
+        fn new(accel: [i16; 3], gyro: [i16; 3], seq: u8) -> Self {
+            Imu { accel, gyro, seq }
+        }
+    }
+);
 
 impl Encoders {
     fn inner(&self) -> p::Encoders {
@@ -420,10 +431,17 @@ impl From<p::Encoders> for Encoders {
         }
     }
 }
-downlink_methods!(Encoders, p::Encoders, |f| format!(
-    "Encoders(ticks={:?}, seq={})",
-    f.ticks, f.seq
-));
+downlink_methods!(
+    Encoders,
+    p::Encoders,
+    |f| format!("Encoders(ticks={:?}, seq={})", f.ticks, f.seq),
+    {
+        #[new]
+        fn new(ticks: [i16; 4], seq: u8) -> Self {
+            Encoders { ticks, seq }
+        }
+    }
+);
 
 impl Battery {
     fn inner(&self) -> p::Battery {
@@ -443,10 +461,24 @@ impl From<p::Battery> for Battery {
         }
     }
 }
-downlink_methods!(Battery, p::Battery, |f| format!(
-    "Battery(centivolts={}, percent={}, seq={})",
-    f.centivolts, f.percent, f.seq
-));
+downlink_methods!(
+    Battery,
+    p::Battery,
+    |f| format!(
+        "Battery(centivolts={}, percent={}, seq={})",
+        f.centivolts, f.percent, f.seq
+    ),
+    {
+        #[new]
+        fn new(centivolts: u16, percent: u16, seq: u8) -> Self {
+            Battery {
+                centivolts,
+                percent,
+                seq,
+            }
+        }
+    }
+);
 
 impl Reply {
     fn inner(&self) -> p::Reply {
@@ -465,13 +497,25 @@ impl From<p::Reply> for Reply {
         }
     }
 }
-downlink_methods!(Reply, p::Reply, |f| format!(
-    "Reply(register={}, value={})",
-    f.register
-        .as_deref()
-        .map_or_else(|| format!("{:#04x}", f.code), |r| format!("{r:?}")),
-    f.value
-));
+downlink_methods!(
+    Reply,
+    p::Reply,
+    |f| format!(
+        "Reply(register={}, value={})",
+        f.register
+            .as_deref()
+            .map_or_else(|| format!("{:#04x}", f.code), |r| format!("{r:?}")),
+        f.value
+    ),
+    {
+        /// The reply to a read of `register` carrying `value`.
+        #[new]
+        fn new(register: &str, value: u32) -> PyResult<Self> {
+            let r = self::register(register)?;
+            Ok(p::Reply::new(r, value).into())
+        }
+    }
+);
 
 /// A 2020 board → master frame as its Python class.
 pub fn downlink(py: Python<'_>, frame: p::Downlink) -> PyResult<Py<PyAny>> {
@@ -703,7 +747,10 @@ impl From<v1::Telemetry> for Telemetry {
 #[pymethods]
 impl Telemetry {
     #[new]
-    #[pyo3(signature = (velocity = [0; 3], accel = [0; 3], gyro = [0; 3], quaternion = [1000, 0, 0, 0], battery_mv = 0))]
+    #[pyo3(
+        signature = (velocity = [0; 3], accel = [0; 3], gyro = [0; 3], quaternion = [1000, 0, 0, 0], battery_mv = 0),
+        text_signature = "(velocity=(0, 0, 0), accel=(0, 0, 0), gyro=(0, 0, 0), quaternion=(1000, 0, 0, 0), battery_mv=0)"
+    )]
     fn new(
         velocity: [i16; 3],
         accel: [i16; 3],
@@ -790,6 +837,19 @@ pub fn reply_fields<'py>(
 
 #[pymethods]
 impl ReadbackReply {
+    /// The reply to the readback `request` (`system`, `geometry`, …) with its ten payload
+    /// bytes.
+    #[new]
+    fn new(request: &str, payload: [u8; 10]) -> PyResult<Self> {
+        let request = v1::Readback::from_name(request).ok_or_else(|| {
+            pyo3::exceptions::PyValueError::new_err(format!(
+                "{request:?} is not a readback: give one of {}",
+                v1::Readback::ALL.map(v1::Readback::name).join(", ")
+            ))
+        })?;
+        Ok(v1::Reply { request, payload }.into())
+    }
+
     /// The readback it answers: `system`, `geometry`, `body-velocity`, `motor-speeds`, `pid`.
     #[getter]
     fn request(&self) -> &'static str {
@@ -844,11 +904,12 @@ pub fn v1_downlink(py: Python<'_>, frame: v1::Downlink) -> PyResult<Py<PyAny>> {
     })
 }
 
-/// A v1.0.0 master → board frame (a command) as a dict: `{"frame": "v1-body-velocity", …}`.
+/// A v1.0.0 master → board frame: a `BodyVelocity`, or a dict as `decode_capture` gives it
+/// (`{"frame": "v1-readback", "request": "system", "code": 51}`).
 pub fn v1_uplink(py: Python<'_>, frame: v1::Command) -> PyResult<Py<PyAny>> {
     if let v1::Command::BodyVelocity(v) = frame {
         return Ok(BodyVelocity::from(v).into_pyobject(py)?.into_any().unbind());
     }
-    let value = serde_json::to_value(frame).map_err(|e| FrameError::new_err(e.to_string()))?;
+    let (value, _) = chassis_capture::describe_v1_uplink(&frame);
     Ok(crate::json::to_py(py, &value)?.unbind())
 }

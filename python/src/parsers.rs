@@ -5,6 +5,7 @@ use crate::frames;
 use chassis_protocol as p;
 use chassis_protocol::v1;
 use pyo3::prelude::*;
+use pyo3::pybacked::PyBackedBytes;
 use pyo3::types::PyDict;
 
 /// The 2020 board → master parser (`FF FA/FB/FC` telemetry, `#` replies), resynchronising on a
@@ -25,8 +26,8 @@ impl DownlinkParser {
     }
 
     /// Takes bytes; the frames they complete, in order (`Imu`, `Encoders`, `Battery`, `Reply`).
-    fn feed(&mut self, py: Python<'_>, data: &[u8]) -> PyResult<Vec<Py<PyAny>>> {
-        let found: Vec<p::Downlink> = py.detach(|| self.inner.frames(data).collect());
+    fn feed(&mut self, py: Python<'_>, data: PyBackedBytes) -> PyResult<Vec<Py<PyAny>>> {
+        let found: Vec<p::Downlink> = py.detach(|| self.inner.frames(&data).collect());
         found.into_iter().map(|f| frames::downlink(py, f)).collect()
     }
 
@@ -89,8 +90,8 @@ impl UplinkParser {
 
     /// Takes bytes; the commands they complete (`Velocity`, `Turn`, `Motors`, `Read`, `Write`,
     /// `Action`).
-    fn feed(&mut self, py: Python<'_>, data: &[u8]) -> PyResult<Vec<Py<PyAny>>> {
-        let found: Vec<p::Command> = py.detach(|| self.inner.frames(data).collect());
+    fn feed(&mut self, py: Python<'_>, data: PyBackedBytes) -> PyResult<Vec<Py<PyAny>>> {
+        let found: Vec<p::Command> = py.detach(|| self.inner.frames(&data).collect());
         found.into_iter().map(|f| frames::uplink(py, f)).collect()
     }
 
@@ -140,9 +141,9 @@ impl V1DownlinkParser {
     }
 
     /// Takes bytes; the frames they complete.
-    fn feed(&mut self, py: Python<'_>, data: &[u8]) -> PyResult<Vec<Py<PyAny>>> {
+    fn feed(&mut self, py: Python<'_>, data: PyBackedBytes) -> PyResult<Vec<Py<PyAny>>> {
         use v1::Parser as _;
-        let found: Vec<v1::Downlink> = py.detach(|| self.inner.frames(data).collect());
+        let found: Vec<v1::Downlink> = py.detach(|| self.inner.frames(&data).collect());
         found
             .into_iter()
             .map(|f| frames::v1_downlink(py, f))
@@ -173,9 +174,9 @@ impl V1UplinkParser {
     }
 
     /// Takes bytes; the commands they complete.
-    fn feed(&mut self, py: Python<'_>, data: &[u8]) -> PyResult<Vec<Py<PyAny>>> {
+    fn feed(&mut self, py: Python<'_>, data: PyBackedBytes) -> PyResult<Vec<Py<PyAny>>> {
         use v1::Parser as _;
-        let found: Vec<v1::Command> = py.detach(|| self.inner.frames(data).collect());
+        let found: Vec<v1::Command> = py.detach(|| self.inner.frames(&data).collect());
         found
             .into_iter()
             .map(|f| frames::v1_uplink(py, f))

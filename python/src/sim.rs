@@ -86,8 +86,8 @@ impl SimBoard {
     }
 
     /// Bytes from the master.
-    fn receive(&mut self, data: &[u8]) {
-        self.board.receive(data);
+    fn receive(&mut self, data: pyo3::pybacked::PyBackedBytes) {
+        self.board.receive(&data);
     }
 
     /// Moves the board's clock to `now_ms`.
@@ -210,10 +210,11 @@ impl SimPty {
     fn __exit__(
         &mut self,
         py: Python<'_>,
-        _kind: Option<Bound<'_, PyAny>>,
-        _value: Option<Bound<'_, PyAny>>,
-        _traceback: Option<Bound<'_, PyAny>>,
+        exc_type: Option<Bound<'_, PyAny>>,
+        exc_value: Option<Bound<'_, PyAny>>,
+        traceback: Option<Bound<'_, PyAny>>,
     ) -> bool {
+        let _ = (exc_type, exc_value, traceback);
         self.close(py);
         false
     }

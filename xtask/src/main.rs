@@ -3,7 +3,9 @@
 //! | task | what it does |
 //! |---|---|
 //! | `demo` | the main job: the bring-up firmware in QEMU (mps2-an386, Cortex-M4) against the simulated chassis over TCP, its log decoded, a verdict |
-//! | `test` | everything CI checks: format, lints, tests, docs, `no_std` builds for Cortex-M, the link-time no-panic proofs (host and firmware), every board's firmware, the size and instruction-count budgets, the end-to-end tests in QEMU, and a short, repeatable run of every fuzz target (fixed seed and run count) |
+//! | `test` | everything CI checks: format, lints, tests, docs, the published crates' packages, the protocol crate's public API against its snapshot, `no_std` builds for Cortex-M, the link-time no-panic proofs (host and firmware), every board's firmware, the size and instruction-count budgets, the end-to-end tests in QEMU, and a short, repeatable run of every fuzz target (fixed seed and run count) |
+//! | `package` | the crates published to the registry packaged together, each built from its package alone; the protocol crate's file list and size (part of `test`) |
+//! | `public-api [--bless]` | the protocol crate's public API (every feature) against `protocol/public-api.txt`; `--bless` writes the snapshot (the check is part of `test`) |
 //! | `size` | flash and RAM of every board's firmware, and the protocol crate's share (size probes) |
 //! | `icount` | the downlink parser's instructions per byte on the emulated Cortex-M4 and Cortex-M0 |
 //! | `fuzz [SECONDS]` | only the fuzz targets, each for SECONDS (default 30), exploring: random seed, corpora kept |
@@ -14,8 +16,8 @@
 //! | `qemu ELF [--scenario NAME]` | boots a firmware in QEMU against the simulated chassis (the QEMU board's cargo runner) |
 //!
 //! Each task installs what it needs (rustup targets, `qemu-system-arm` through apt when run as
-//! root, defmt-print, the nightly toolchain and cargo-fuzz) before it runs, so a fresh machine
-//! with rustup and cargo needs nothing else.
+//! root, defmt-print, the nightly toolchain, cargo-fuzz and cargo-public-api) before it runs, so
+//! a fresh machine with rustup and cargo needs nothing else.
 
 mod firmware;
 
@@ -34,6 +36,8 @@ fn main() -> ExitCode {
         "qemu" => firmware::qemu(&std::env::args().skip(2).collect::<Vec<_>>()),
         "test" => test(),
         "python" => python(),
+        "package" => package(),
+        "public-api" => public_api(&std::env::args().skip(2).collect::<Vec<_>>()),
         "sweep" => sweep(&std::env::args().skip(2).collect::<Vec<_>>()),
         "bench" => bench(&std::env::args().skip(2).collect::<Vec<_>>()),
         "fuzz" => {
@@ -47,8 +51,9 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask <demo | test | python | size | icount | sweep [--seed N] | bench [--runs N] | fuzz [SECONDS] | \
-                 host-demo | qemu FIRMWARE.elf>"
+                "usage: cargo xtask <demo | test | python | package | public-api [--bless] | size | \
+                 icount | sweep [--seed N] | bench [--runs N] | fuzz [SECONDS] | host-demo | \
+                 qemu FIRMWARE.elf>"
             );
             return ExitCode::from(2);
         }
@@ -382,6 +387,10 @@ fn test() -> Result<(), String> {
         let doc = ["doc", "-p", "chassis-protocol", "--no-deps", features];
         run_with(&cargo_program(), &doc, &[("RUSTDOCFLAGS", "-D warnings")])?;
     }
+    // The published crates package, and each builds from its package alone.
+    package()?;
+    // The protocol crate's public API is the one in its snapshot.
+    public_api(&[])?;
     // The benchmarks build (running them is `cargo xtask bench`: timings do not belong in CI).
     cargo(&[
         "bench",
@@ -395,6 +404,239 @@ fn test() -> Result<(), String> {
     python()?;
     firmware::test()?;
     fuzz(FuzzRun::Repeatable)
+}
+
+/// The crates published to the registry, each after those it depends on. Every other member
+/// keeps the workspace's `publish = false`.
+const PUBLISHED: [&str; 4] = [
+    "chassis-protocol",
+    "chassis-bringup",
+    "chassis-capture",
+    "chassis-cli",
+];
+
+/// The published crates packaged together, as `cargo publish --workspace` would upload them:
+/// each `.crate` is unpacked and built on its own, its local dependencies taken from their
+/// packages (not from the workspace), so a file left out of a package, a path dependency
+/// without a version or a manifest the registry would refuse fails here. Prints what goes into
+/// the protocol crate's package and the size of its `.crate`.
+///
+/// `--allow-dirty`: the package is made of the files on disk, as the rest of `test` checks them
+/// (CI's clone is clean anyway; a developer's work in progress must not fail this step).
+fn package() -> Result<(), String> {
+    let list = cargo_stdout(&[
+        "package",
+        "--quiet",
+        "--allow-dirty",
+        "--list",
+        "-p",
+        "chassis-protocol",
+    ])?;
+    let mut args = vec!["package", "--quiet", "--allow-dirty"];
+    for name in PUBLISHED {
+        args.extend(["-p", name]);
+    }
+    cargo(&args)?;
+    let dir = target_dir()?.join("package");
+    let newest = std::fs::read_dir(&dir)
+        .map_err(|e| format!("cannot read {}: {e}", dir.display()))?
+        .filter_map(Result::ok)
+        .filter(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            name.starts_with("chassis-protocol-") && name.ends_with(".crate")
+        })
+        .filter_map(|e| Some((e.metadata().ok()?.modified().ok()?, e.path())))
+        .max()
+        .map(|(_, path)| path)
+        .ok_or_else(|| format!("no chassis-protocol .crate in {}", dir.display()))?;
+    let bytes = std::fs::metadata(&newest)
+        .map_err(|e| format!("cannot read {}: {e}", newest.display()))?
+        .len();
+    let files: Vec<&str> = list.lines().filter(|l| !l.is_empty()).collect();
+    println!(
+        "chassis-protocol's package: {} files, {:.1} KiB ({})",
+        files.len(),
+        bytes as f64 / 1024.0,
+        newest.file_name().unwrap_or_default().to_string_lossy()
+    );
+    for file in files {
+        println!("  {file}");
+    }
+    Ok(())
+}
+
+/// What `cargo <args>` prints on standard output; its standard error is shown only if it fails.
+fn cargo_stdout(args: &[&str]) -> Result<String, String> {
+    cargo_stdout_with(args, &[])
+}
+
+/// [`cargo_stdout`], with extra environment variables, through the rustup proxy (so that a
+/// `+toolchain` argument, or a tool that gives one itself, works).
+fn cargo_stdout_with(args: &[&str], env: &[(&str, &std::path::Path)]) -> Result<String, String> {
+    eprintln!("$ cargo {}", args.join(" "));
+    let output = Command::new("cargo")
+        .args(args)
+        .envs(env.iter().copied())
+        .output()
+        .map_err(|e| format!("could not start cargo: {e}"))?;
+    if !output.status.success() {
+        eprint!("{}", String::from_utf8_lossy(&output.stderr));
+        return Err(format!(
+            "`cargo {}` failed ({})",
+            args.join(" "),
+            output.status
+        ));
+    }
+    Ok(String::from_utf8_lossy(&output.stdout).into_owned())
+}
+
+/// The build directory: `CARGO_TARGET_DIR`, or `target/` at the root.
+fn target_dir() -> Result<std::path::PathBuf, String> {
+    match std::env::var_os("CARGO_TARGET_DIR") {
+        Some(dir) => Ok(dir.into()),
+        None => Ok(workspace_root()?.join("target")),
+    }
+}
+
+/// The checked-in public API of `chassis-protocol` with every feature, one item per line, as
+/// cargo-public-api lists it.
+const PUBLIC_API_SNAPSHOT: &str = "protocol/public-api.txt";
+
+/// cargo-public-api's version, pinned: each release reads the rustdoc JSON of a range of
+/// nightlies (0.52.0 reads that of nightly 2026-05-19, the one installed here).
+const CARGO_PUBLIC_API: &str = "0.52.0";
+
+/// How many removed or added lines a failed check shows.
+const PUBLIC_API_SHOWN: usize = 40;
+
+/// The protocol crate's public API (every feature) against its snapshot; `--bless` writes the
+/// snapshot instead. A difference fails: a removed or changed item is a breaking change, an
+/// added one a feature, and either way the snapshot and the changelog say so in the same
+/// commit.
+fn public_api(args: &[String]) -> Result<(), String> {
+    let bless = match args {
+        [] => false,
+        [flag] if flag == "--bless" => true,
+        _ => return Err("usage: cargo xtask public-api [--bless]".to_string()),
+    };
+    let current = current_public_api()?;
+    let path = workspace_root()?.join(PUBLIC_API_SNAPSHOT);
+    if bless {
+        std::fs::write(&path, &current)
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        eprintln!(
+            "wrote {PUBLIC_API_SNAPSHOT}: {} lines",
+            current.lines().count()
+        );
+        return Ok(());
+    }
+    let snapshot = std::fs::read_to_string(&path).map_err(|e| {
+        format!(
+            "cannot read {PUBLIC_API_SNAPSHOT} ({e}): write it with `cargo xtask public-api --bless`"
+        )
+    })?;
+    let snapshot = snapshot.replace("\r\n", "\n");
+    if snapshot == current {
+        eprintln!(
+            "chassis-protocol's public API: as in {PUBLIC_API_SNAPSHOT} ({} lines)",
+            current.lines().count()
+        );
+        return Ok(());
+    }
+    let old: std::collections::BTreeSet<&str> = snapshot.lines().collect();
+    let new: std::collections::BTreeSet<&str> = current.lines().collect();
+    let show = |title: &str, sign: char, lines: Vec<&&str>| {
+        if lines.is_empty() {
+            return;
+        }
+        eprintln!("{title} ({}):", lines.len());
+        for line in lines.iter().take(PUBLIC_API_SHOWN) {
+            eprintln!("  {sign} {line}");
+        }
+        if lines.len() > PUBLIC_API_SHOWN {
+            eprintln!("  … and {} more", lines.len() - PUBLIC_API_SHOWN);
+        }
+    };
+    show(
+        "removed or changed: a breaking change",
+        '-',
+        old.difference(&new).collect(),
+    );
+    show("added", '+', new.difference(&old).collect());
+    if old == new {
+        eprintln!("(the same lines, in another order or repeated another number of times)");
+    }
+    Err(format!(
+        "the public API of chassis-protocol (every feature) differs from {PUBLIC_API_SNAPSHOT} \
+         (above). A removed or changed line is a breaking change (the next release is a major \
+         one: 0.x → 0.(x+1)); an added one is a feature. If the change is intended, update the \
+         snapshot with `cargo xtask public-api --bless` and add an entry under [Unreleased] in \
+         protocol/CHANGELOG.md, in the same commit."
+    ))
+}
+
+/// The protocol crate's public API now, as cargo-public-api lists it from the nightly rustdoc's
+/// JSON (its own target directory: the nightly's artefacts would only evict the main ones).
+/// Left out: blanket impls (`impl<T> From<T> for T`: the standard library's, not this crate's)
+/// and the auto traits stable Rust cannot name (`Freeze`, `UnsafeUnpin`: they come and go with
+/// the nightly). `Send`, `Sync`, `Unpin` and the unwind-safety traits stay: losing one breaks
+/// users.
+fn current_public_api() -> Result<String, String> {
+    install_nightly()?;
+    install_cargo_public_api()?;
+    let target = target_dir()?.join("public-api");
+    let listed = cargo_stdout_with(
+        &[
+            "public-api",
+            "--manifest-path",
+            &workspace_root()?.join("Cargo.toml").to_string_lossy(),
+            "-p",
+            "chassis-protocol",
+            "--all-features",
+            "--omit",
+            "blanket-impls",
+            "--color",
+            "never",
+        ],
+        &[("CARGO_TARGET_DIR", &target)],
+    )?;
+    let unstable_auto_trait = |line: &str| {
+        line.starts_with("impl")
+            && (line.contains(" core::marker::Freeze for ")
+                || line.contains(" core::marker::UnsafeUnpin for "))
+    };
+    let mut api = String::new();
+    for line in listed.lines().filter(|l| !unstable_auto_trait(l)) {
+        api.push_str(line);
+        api.push('\n');
+    }
+    Ok(api)
+}
+
+/// Installs cargo-public-api ([`CARGO_PUBLIC_API`]) unless that version is there.
+fn install_cargo_public_api() -> Result<(), String> {
+    let present = Command::new("cargo")
+        .args(["public-api", "--version"])
+        .output()
+        .is_ok_and(|o| {
+            o.status.success()
+                && String::from_utf8_lossy(&o.stdout)
+                    .split_whitespace()
+                    .any(|word| word == CARGO_PUBLIC_API)
+        });
+    if present {
+        return Ok(());
+    }
+    // A debug build: a minute of compiling less than a release one on two cores, and it reads
+    // this crate's JSON in about a second all the same.
+    cargo(&[
+        "install",
+        "--locked",
+        "--debug",
+        "cargo-public-api",
+        "--version",
+        CARGO_PUBLIC_API,
+    ])
 }
 
 /// The Python package: built as a user builds it (`pip install ./python`, maturin as the build
@@ -439,6 +681,19 @@ fn python() -> Result<(), String> {
             &python,
             &["-m", "mypy", "--strict", &examples.to_string_lossy()],
         )?;
+    }
+    // The type stubs against the built module (run away from the source tree, so that the
+    // installed package is the one imported).
+    eprintln!("$ python -m mypy.stubtest chassis.chassis_native");
+    let status = Command::new(&python)
+        .args(["-m", "mypy.stubtest", "chassis.chassis_native"])
+        .current_dir(&venv)
+        .status()
+        .map_err(|e| format!("could not start {python}: {e}"))?;
+    if !status.success() {
+        return Err(format!(
+            "the type stubs (python/chassis/chassis_native.pyi) differ from the module ({status})"
+        ));
     }
     Ok(())
 }
