@@ -30,7 +30,7 @@ pub struct Board {
 }
 
 /// Every board the firmware is built for; the first runs in QEMU.
-pub const BOARDS: [Board; 5] = [
+pub const BOARDS: [Board; 6] = [
     Board {
         dir: "qemu-an386",
         name: "QEMU mps2-an386 (Cortex-M4), blocking driver",
@@ -60,6 +60,12 @@ pub const BOARDS: [Board; 5] = [
         name: "ESP32-C3 (RISC-V), esp-hal, blocking driver",
         target: RV32,
         bin: "bringup-esp32c3",
+    },
+    Board {
+        dir: "nrf52840",
+        name: "nRF52840 (Cortex-M4F), embassy, async driver",
+        target: M4,
+        bin: "bringup-nrf52840",
     },
 ];
 
@@ -352,7 +358,10 @@ pub mod budget {
     /// Hardware boards' budgets, by directory: (flash, static RAM), a little above what each
     /// measured when it was added (a regression guard; the ESP32-C3's RAM counts the 3 KiB of
     /// code esp-hal runs from its SRAM).
-    pub const BOARDS: [(&str, u64, u64); 1] = [("esp32c3", 70 * 1024, 5 * 1024)];
+    pub const BOARDS: [(&str, u64, u64); 2] = [
+        ("esp32c3", 70 * 1024, 5 * 1024),
+        ("nrf52840", 48 * 1024, 4 * 1024),
+    ];
 }
 
 /// Builds the probes and the bring-up firmware, prints the table, returns whether every
