@@ -1,6 +1,7 @@
 //! Host-side test support for `chassis-protocol`: a model of the board's telemetry stream, a
 //! noisy UART channel, and the scoring of a parser against what was sent. Shared by the
-//! integration tests, the property tests, the fuzz targets, the noise sweep and the demo.
+//! integration tests, the property tests, the fuzz targets, the noise sweep and the demo. The
+//! same for the v1.0.0 firmware's board → master stream: [`v1`].
 //!
 //! Everything is seeded: the same seed gives the same bytes, so every figure repeats.
 
@@ -9,6 +10,7 @@ pub mod channel;
 pub mod qemu;
 pub mod score;
 pub mod splice;
+pub mod v1;
 
 pub use board::{BoardStream, CountModel, Gap, Payload, Read, SentFrame, reads_behind};
 pub use channel::{Noise, Received};
