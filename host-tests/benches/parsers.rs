@@ -8,9 +8,15 @@
 //!
 //! Streams: about 1 MB each, built here. Ours is the board's telemetry mix at rest (IMU 100 Hz,
 //! encoders 25 Hz, battery 1 Hz, replies), back to back; random bytes for the worst case.
+//!
+//! Beside them, in the same run, the v1.0.0 firmware's board → master parser
+//! (`chassis_protocol::v1::DownlinkParser`) on about 1 MB of its own board's stream (32-byte
+//! telemetry of a driven chassis, a reply a second: `chassis_host_tests::v1::Board`), frames back
+//! to back, and on the same random bytes.
 
 use chassis_host_tests::BoardStream;
 use chassis_protocol::DownlinkParser;
+use chassis_protocol::v1::{self, Parser as _};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -22,6 +28,12 @@ const STREAM_BYTES: usize = 1 << 20;
 fn telemetry() -> Vec<u8> {
     let (bytes, _) = BoardStream::new(2026, 2.0).take(STREAM_BYTES / 14);
     bytes
+}
+
+/// The v1.0.0 board's stream: frames until there is 1 MiB.
+fn v1_telemetry() -> (Vec<u8>, usize) {
+    let stream = chassis_host_tests::v1::Board::new(2026, 1.0).take(STREAM_BYTES / 31);
+    (stream.bytes, stream.frames.len())
 }
 
 fn random() -> Vec<u8> {
@@ -85,6 +97,30 @@ fn ours_bytewise(bytes: &[u8]) -> usize {
 
 fn ours_slices(bytes: &[u8]) -> usize {
     let mut parser = DownlinkParser::new();
+    let mut n = 0;
+    for chunk in bytes.chunks(64) {
+        n += parser.frames(chunk).count();
+    }
+    n
+}
+
+fn v1_bytewise(bytes: &[u8]) -> usize {
+    let mut parser = v1::DownlinkParser::new();
+    let mut n = 0;
+    for b in bytes {
+        if parser.push(*b).is_some() {
+            n += 1;
+            // A frame found inside a damaged one may follow.
+            while parser.poll().is_some() {
+                n += 1;
+            }
+        }
+    }
+    n
+}
+
+fn v1_slices(bytes: &[u8]) -> usize {
+    let mut parser = v1::DownlinkParser::new();
     let mut n = 0;
     for chunk in bytes.chunks(64) {
         n += parser.frames(chunk).count();
@@ -177,14 +213,18 @@ fn benches(c: &mut Criterion) {
     let random = random();
     let sbus = sbus();
     let crsf = crsf();
+    let (v1, v1_frames) = v1_telemetry();
     // Each parser must actually find its frames, or the comparison means nothing.
+    assert_eq!(v1_bytewise(&v1), v1_frames);
+    assert_eq!(v1_slices(&v1), v1_frames);
     assert!(ours_bytewise(&telemetry) > telemetry.len() / 16);
     assert_eq!(ours_slices(&telemetry), ours_bytewise(&telemetry));
     assert!(sbus_bytewise(&sbus) > sbus.len() / 26);
     eprintln!(
-        "frames found: chassis {} of {} bytes; sbus-rs {}, uf-crsf {}, crsf {} of {} packets",
+        "frames found: chassis {} of {} bytes; v1 {v1_frames} of {} bytes; sbus-rs {}, uf-crsf {}, crsf {} of {} packets",
         ours_bytewise(&telemetry),
         telemetry.len(),
+        v1.len(),
         sbus_bytewise(&sbus),
         uf_crsf_slices(&crsf),
         crsf_slices(&crsf),
@@ -201,7 +241,7 @@ fn benches(c: &mut Criterion) {
         .sample_size(11)
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(2));
-    let runs: [Run; 8] = [
+    let runs: [Run; 12] = [
         ("byte path: chassis telemetry", &telemetry, ours_bytewise),
         ("byte path: sbus-rs", &sbus, sbus_bytewise),
         (
@@ -214,6 +254,10 @@ fn benches(c: &mut Criterion) {
         ("slice path: uf-crsf", &crsf, uf_crsf_slices),
         ("slice path: crsf", &crsf, crsf_slices),
         ("slice path: chassis random bytes", &random, ours_slices),
+        ("byte path: chassis v1 telemetry", &v1, v1_bytewise),
+        ("byte path: chassis v1 random bytes", &random, v1_bytewise),
+        ("slice path: chassis v1 telemetry", &v1, v1_slices),
+        ("slice path: chassis v1 random bytes", &random, v1_slices),
     ];
     for (name, bytes, run) in runs {
         group.throughput(Throughput::Bytes(bytes.len() as u64));

@@ -7,10 +7,10 @@
 //! | `package` | the crates published to the registry packaged together, each built from its package alone; the protocol crate's file list and size (part of `test`) |
 //! | `public-api [--bless]` | the protocol crate's public API (every feature) against `protocol/public-api.txt`; `--bless` writes the snapshot (the check is part of `test`) |
 //! | `size` | flash and RAM of every board's firmware, and the protocol crate's share (size probes) |
-//! | `icount` | the downlink parser's instructions per byte on the emulated Cortex-M4 and Cortex-M0 |
+//! | `icount` | the downlink parsers' (2020 and v1.0.0) instructions per byte on the emulated Cortex-M4 and Cortex-M0 |
 //! | `fuzz [SECONDS]` | only the fuzz targets, each for SECONDS (default 30), exploring: random seed, corpora kept |
-//! | `sweep [--seed N]` | the full noise sweep of the downlink parser over every stream model (a few minutes; not part of `test`) |
-//! | `bench [--runs N]` | the parser beside its peers (sbus-rs, uf-crsf, crsf) in one run (or N: the median of each run's ratios): a table with the ratios (not part of `test`, which only builds it) |
+//! | `sweep [--seed N] [--v1]` | the full noise sweep of the downlink parser over every stream model (a few minutes; not part of `test`), then the v1.0.0 board → master parser's (`--v1`: only that one, about 15 s) |
+//! | `bench [--runs N]` | the parser beside its peers (sbus-rs, uf-crsf, crsf) and the v1.0.0 parser in one run (or N: the median of each run's ratios): a table with the ratios (not part of `test`, which only builds it) |
 //! | `python` | the Python package built into a virtual environment (`target/python-venv`) as `pip install ./python` builds it, its pytest suite and `mypy --strict` on its examples (part of `test`) |
 //! | `host-demo` | frames built and a noisy board stream parsed, on the host |
 //! | `qemu ELF [--scenario NAME]` | boots a firmware in QEMU against the simulated chassis (the QEMU board's cargo runner) |
@@ -52,7 +52,7 @@ fn main() -> ExitCode {
         _ => {
             eprintln!(
                 "usage: cargo xtask <demo | test | python | package | public-api [--bless] | size | \
-                 icount | sweep [--seed N] | bench [--runs N] | fuzz [SECONDS] | host-demo | \
+                 icount | sweep [--seed N] [--v1] | bench [--runs N] | fuzz [SECONDS] | host-demo | \
                  qemu FIRMWARE.elf>"
             );
             return ExitCode::from(2);
@@ -189,10 +189,36 @@ const BENCH_FLOOR: [(&str, &str, &str); 2] = [
     ),
 ];
 
+/// Not goals: the v1.0.0 board → master parser beside the 2020 one, each on its own board's
+/// stream (and both on the same random bytes), in the same run.
+const BENCH_GENERATIONS: [(&str, &str, &str); 4] = [
+    (
+        "v1 ÷ 2020, byte path, each board's stream",
+        "byte path: chassis v1 telemetry",
+        "byte path: chassis telemetry",
+    ),
+    (
+        "v1 ÷ 2020, slice path, each board's stream",
+        "slice path: chassis v1 telemetry",
+        "slice path: chassis telemetry",
+    ),
+    (
+        "v1 ÷ 2020, byte path, random bytes",
+        "byte path: chassis v1 random bytes",
+        "byte path: chassis random bytes",
+    ),
+    (
+        "v1 ÷ 2020, slice path, random bytes",
+        "slice path: chassis v1 random bytes",
+        "slice path: chassis random bytes",
+    ),
+];
+
 /// Runs the parser benchmark (`host-tests/benches/parsers.rs`: this parser and its peers in one
 /// run) `runs` times and prints one table with the ratios the parser issue sets as goals: each
 /// ratio is taken within a run (peers measured minutes apart on a shared machine are not
-/// comparable), and the median over the runs is the one judged.
+/// comparable), and the median over the runs is the one judged. Then the floor, and the v1.0.0
+/// parser beside the 2020 one ([`BENCH_GENERATIONS`]).
 fn bench(args: &[String]) -> Result<(), String> {
     let runs = match args {
         [] => 1,
@@ -262,6 +288,11 @@ fn bench(args: &[String]) -> Result<(), String> {
         let each = per_run(a, b);
         println!("{what}: {:.2} ({})", median(each.clone()), show(&each));
     }
+    println!();
+    for (what, a, b) in BENCH_GENERATIONS {
+        let each = per_run(a, b);
+        println!("{what}: {:.2} ({})", median(each.clone()), show(&each));
+    }
     Ok(())
 }
 
@@ -313,10 +344,25 @@ fn bench_once() -> Result<Vec<(String, f64)>, String> {
     Ok(rates)
 }
 
-/// The noise sweep; `--seed N` for a seed other than the one the figures quote.
+/// The noise sweeps: the 2020 parser's (`noise-sweep`), then the v1.0.0 board → master
+/// parser's (example `v1_sweep`); `--v1` runs only the second; `--seed N` for a seed other than
+/// the one the figures quote.
 fn sweep(args: &[String]) -> Result<(), String> {
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    host_tests("--bin", "noise-sweep", &args)
+    let v1_only = args.iter().any(|a| a == "--v1");
+    let args: Vec<&str> = args
+        .iter()
+        .map(String::as_str)
+        .filter(|a| *a != "--v1")
+        .collect();
+    match args.as_slice() {
+        [] | ["--seed", _] => {}
+        _ => return Err("usage: cargo xtask sweep [--seed N] [--v1]".to_string()),
+    }
+    if !v1_only {
+        host_tests("--bin", "noise-sweep", &args)?;
+        println!();
+    }
+    host_tests("--example", "v1_sweep", &args)
 }
 
 fn test() -> Result<(), String> {
