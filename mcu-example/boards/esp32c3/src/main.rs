@@ -9,6 +9,10 @@
 //! UART and a clock, the bring-up then has no future (and no executor, timer queue or
 //! interrupt handler of its own), and a loop that never sleeps for more than a log line reads
 //! the 128-byte receive FIFO long before it fills (11 ms of a saturated 115 200 bps link).
+//! The async way builds on stable as well (esp-rtos 0.4 with `embassy`, on embassy-executor
+//! 0.10; esp-hal's `Uart<Async>` has `read_async` and `write_async`, both documented
+//! cancel-safe, as the async driver needs), but a trial build of the same bring-up that way
+//! took 87.8 KB of flash and 9.4 KB of RAM, against this board's 66.1 KB and 4.4 KB.
 //!
 //! Pins: GPIO20/GPIO21 are UART0's (the USB-UART bridge of the DevKits, and where the ROM boot
 //! loader prints at reset), GPIO18/19 are USB, GPIO2/8/9 are strapping pins: GPIO4 and GPIO5
