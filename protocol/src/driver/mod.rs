@@ -17,12 +17,13 @@
 //! | HAL | UART type | implements | use |
 //! |---|---|---|---|
 //! | embassy-stm32 0.6 | `BufferedUart` (or its `split()` halves) | embedded-io 0.7 and embedded-io-async 0.7, with `ReadReady` | [`asynch::Driver`] (halves through [`Split`]), or [`blocking::Driver`] |
-//! | embassy-stm32 0.6 | `Uart<Async>` | embedded-io-async, no `ReadReady`; a DMA read is not cancel-safe | use `BufferedUart` instead |
+//! | embassy-stm32 0.6 | `Uart<Async>` | only `Write` (embedded-io 0.7 and embedded-io-async 0.7) and embedded-hal-nb; no `Read` trait: its DMA `read` / `read_until_idle` are inherent methods, not cancel-safe | use `BufferedUart`, or `RingBufferedUartRx` for the receive side |
+//! | embassy-stm32 0.6 | `RingBufferedUartRx` (`UartRx<Async>::into_ring_buffered`) | RX only: embedded-io-async 0.7 `Read` + `ReadReady`, embedded-hal-nb `Read`; `read` is cancel-safe (copies out of the DMA ring, awaits only the half/full or idle interrupt) | [`asynch::Driver`] through [`Split`] with a TX half whose write takes no byte when dropped (not `UartTx<Async>`'s DMA write), or the [`DriverCore`] fed slices (`mcu-example/boards/stm32-dma`) |
 //! | embassy-rp 0.10 | `BufferedUart` | as embassy-stm32's | as embassy-stm32's |
-//! | embassy-nrf 0.11 | `BufferedUarte` (and its halves) | embedded-io-async 0.7 `Read + Write + ReadReady` only | [`asynch::Driver`] |
+//! | embassy-nrf 0.11 | `BufferedUarte` (and its halves) | embedded-io-async 0.7 `Read + Write + ReadReady` (and `BufRead`); no blocking embedded-io | [`asynch::Driver`] (`mcu-example/boards/nrf52840`) |
 //! | rp2040-hal 0.12 | `UartPeripheral` | embedded-io 0.7 and embedded-hal-nb 1.0 | [`blocking::Driver`] directly, or through `NbSerial` |
 //! | stm32f4xx-hal 0.23 | `Serial` | embedded-hal-nb 1.0; of embedded-io 0.6 only `Write` | `NbSerial` (not `Io06`: no 0.6 `Read`) |
-//! | esp-hal 1.x | `Uart` | embedded-io 0.7 behind its `unstable` feature; no embedded-hal-nb | [`blocking::Driver`] with esp-hal's `unstable` on |
+//! | esp-hal 1.2 | `Uart` (`Blocking` or `Async`, and its `UartRx` / `UartTx` halves) | behind its `unstable` feature: embedded-io 0.7 (and 0.6) `Read + Write + ReadReady`; `Uart<Async>` also embedded-io-async 0.7 `Read + Write`, `read_async` / `write_async` documented cancel-safe; no embedded-hal-nb | [`blocking::Driver`] with esp-hal's `unstable` on (`mcu-example/boards/esp32c3`), or [`asynch::Driver`] on `Uart<Async>` under esp-rtos's embassy executor |
 //!
 //! # The safety model
 //!
