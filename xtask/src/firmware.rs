@@ -1,6 +1,6 @@
 //! The firmware tasks: `demo` (the bring-up in QEMU), `qemu ELF` (the QEMU board's cargo
-//! runner), `size`, and the firmware half of `test` (every board built, the firmware's no-panic
-//! proof, the size budgets, the end-to-end tests in QEMU).
+//! runner), `size`, `icount`, and the firmware half of `test` (every board built, the firmware's
+//! no-panic proof, the size budgets, the end-to-end tests in QEMU).
 
 use crate::{cargo, cargo_program, install_targets, run_with, workspace_root};
 use std::path::{Path, PathBuf};
@@ -334,12 +334,15 @@ pub fn sizes(elf: &Path) -> Result<Sizes, String> {
 }
 
 /// The size probes of the QEMU board (`src/bin/size_*.rs`), each the board plus one part.
-const PROBES: [&str; 5] = [
+const PROBES: [&str; 8] = [
     "size_baseline",
     "size_parsers",
     "size_builders",
     "size_protocol",
     "size_driver",
+    "size_downlink",
+    "size_v1_downlink",
+    "size_v1_parsers",
 ];
 
 /// The budgets of the firmware issue, in bytes.
@@ -369,6 +372,9 @@ pub mod budget {
         ("nrf52840", 48 * 1024, 4 * 1024),
         ("stm32-dma", 50 * 1024, 4 * 1024),
     ];
+    /// What the v1.0.0 board → master parser may not grow past (`size_v1_downlink` − board): a
+    /// regression guard a little above what it measured when it was set (2 424 B).
+    pub const V1_DOWNLINK_CEILING: u64 = 2_600;
 }
 
 /// Builds the probes and the bring-up firmware, prints the table, returns whether every
@@ -454,6 +460,18 @@ pub fn size_table() -> Result<bool, String> {
         "| driver alone | {} B | `size_driver` − `size_protocol` |",
         probe[4].flash.saturating_sub(probe[3].flash)
     );
+    println!(
+        "| board → master parser alone (`DownlinkParser`) | {} B | `size_downlink` − board |",
+        part(5)
+    );
+    let v1_downlink = part(6);
+    println!(
+        "| v1.0.0 board → master parser (`v1::DownlinkParser`) | {v1_downlink} B | `size_v1_downlink` − board |"
+    );
+    println!(
+        "| v1.0.0 parsers (board → master and master → board) | {} B | `size_v1_parsers` − board |",
+        part(7)
+    );
     let goal = protocol <= budget::PROTOCOL_GOAL;
     println!(
         "\nparsers + builders: {protocol} B against the 4 KiB goal: {}; ceiling {} B (regression guard): {}",
@@ -465,7 +483,13 @@ pub fn size_table() -> Result<bool, String> {
             "EXCEEDED"
         }
     );
-    Ok(fw_ok && protocol <= budget::PROTOCOL_CEILING)
+    let v1_ok = v1_downlink <= budget::V1_DOWNLINK_CEILING;
+    println!(
+        "v1.0.0 board → master parser: {v1_downlink} B, ceiling {} B (regression guard): {}",
+        budget::V1_DOWNLINK_CEILING,
+        if v1_ok { "held" } else { "EXCEEDED" }
+    );
+    Ok(fw_ok && protocol <= budget::PROTOCOL_CEILING && v1_ok)
 }
 
 /// `cargo xtask size`.
@@ -499,20 +523,35 @@ const ICOUNT_MACHINES: [IcountMachine; 2] = [
 /// is not met.
 pub const ICOUNT_CEILING_M4: u64 = 90;
 
-/// Runs the instruction-count binary on both emulated cores and prints the figures; returns
-/// the Cortex-M4's instructions per byte on the telemetry mix (`push`).
-pub fn icount_table() -> Result<u64, String> {
+/// What the v1.0.0 board → master parser may not grow past on its board's stream, in
+/// instructions per byte on the Cortex-M4 through `push` (measured 93.5 when it was set): a
+/// regression guard.
+pub const ICOUNT_V1_CEILING_M4: u64 = 100;
+
+/// The Cortex-M4's instructions per byte on each parser's telemetry mix, through `push`.
+#[derive(Clone, Copy, Debug)]
+pub struct IcountM4 {
+    /// The 2020 parser.
+    pub parser_2020: u64,
+    /// The v1.0.0 board → master parser.
+    pub v1: u64,
+}
+
+/// Runs the instruction-count binary on both emulated cores and prints the figures, a row per
+/// core and parser; returns the Cortex-M4's instructions per byte on each telemetry mix
+/// (`push`).
+pub fn icount_table() -> Result<IcountM4, String> {
     install_targets(&[M4, M0])?;
     ensure_qemu()?;
     let board = &BOARDS[0];
     let mut m4_push = None;
     println!(
-        "\nthe downlink parser under QEMU with `-icount shift=0` (one instruction a nanosecond; SysTick counts them)\n"
+        "\nthe downlink parsers under QEMU with `-icount shift=0` (one instruction a nanosecond; SysTick counts them), each on its own board's stream\n"
     );
     println!(
-        "| core | telemetry mix, `push` | telemetry mix, slices | random bytes, `push` | frame-completing byte | saturated 115 200 bps link |"
+        "| core | parser | telemetry mix, `push` | telemetry mix, slices | random bytes, `push` | frame-completing byte | saturated 115 200 bps link |"
     );
-    println!("|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|");
     for machine in &ICOUNT_MACHINES {
         build_board(
             board,
@@ -520,83 +559,117 @@ pub fn icount_table() -> Result<u64, String> {
                 "--no-default-features",
                 "--bin",
                 "icount",
+                "--bin",
+                "icount_v1",
                 "--target",
                 machine.target,
             ],
             &[("DEFMT_LOG", "off")],
         )?;
-        let elf = elf(
-            &Board {
-                target: machine.target,
-                ..*board
-            },
-            "icount",
-        )?;
-        let output = Command::new("qemu-system-arm")
-            .args(machine.qemu)
-            .args(["-display", "none", "-monitor", "none"])
-            .args(["-semihosting-config", "enable=on,target=native"])
-            .args(["-icount", "shift=0", "-kernel"])
-            .arg(&elf)
-            .output()
-            .map_err(|e| format!("could not start qemu-system-arm: {e}"))?;
-        let text = String::from_utf8_lossy(&output.stdout);
-        if !output.status.success() {
-            return Err(format!(
-                "the instruction-count run failed ({}):\n{text}",
-                output.status
-            ));
-        }
-        // "... {} milli-instructions per byte" / "... {} milli-instructions each".
-        let milli = |prefix: &str| -> Result<u64, String> {
-            let line = text
+        // Each parser in its own binary: the 2020 one (`icount`), then the v1.0.0 one
+        // (`icount_v1`, whose lines start with `v1 `).
+        let mut pushes = [0u64; 2];
+        for (i, (parser, bin, prefix)) in [("2020", "icount", ""), ("v1.0.0", "icount_v1", "v1 ")]
+            .into_iter()
+            .enumerate()
+        {
+            let elf = elf(
+                &Board {
+                    target: machine.target,
+                    ..*board
+                },
+                bin,
+            )?;
+            let output = Command::new("qemu-system-arm")
+                .args(machine.qemu)
+                .args(["-display", "none", "-monitor", "none"])
+                .args(["-semihosting-config", "enable=on,target=native"])
+                .args(["-icount", "shift=0", "-kernel"])
+                .arg(&elf)
+                .output()
+                .map_err(|e| format!("could not start qemu-system-arm: {e}"))?;
+            let text = String::from_utf8_lossy(&output.stdout);
+            if !output.status.success() {
+                return Err(format!(
+                    "the instruction-count run failed ({}):\n{text}",
+                    output.status
+                ));
+            }
+            // "... {} milli-instructions per byte" / "... {} milli-instructions each".
+            let milli = |what: &str| -> Result<u64, String> {
+                let prefix = format!("{prefix}{what}");
+                let line = text
+                    .lines()
+                    .find(|l| l.starts_with(&prefix))
+                    .ok_or_else(|| format!("no {prefix:?} line in:\n{text}"))?;
+                line.split_whitespace()
+                    .rev()
+                    .find_map(|w| w.parse::<u64>().ok())
+                    .ok_or_else(|| format!("no figure in {line:?}"))
+            };
+            let machine_name = text
                 .lines()
-                .find(|l| l.starts_with(prefix))
-                .ok_or_else(|| format!("no {prefix:?} line in:\n{text}"))?;
-            line.split_whitespace()
-                .rev()
-                .find_map(|w| w.parse::<u64>().ok())
-                .ok_or_else(|| format!("no figure in {line:?}"))
-        };
-        let machine_name = text
-            .lines()
-            .next()
-            .unwrap_or("?")
-            .trim_start_matches("machine: ");
-        let calibration = text
-            .lines()
-            .find(|l| l.starts_with("calibration"))
-            .unwrap_or("");
-        let push = milli("telemetry mix, push")?;
-        let slices = milli("telemetry mix, slices")?;
-        let random = milli("random bytes, push")?;
-        let completing = milli("frame-completing byte")?;
-        // 11 520 bytes a second; at one instruction a cycle (a floor: a Cortex-M0+ averages
-        // more), the share of a 48 MHz core.
-        let load = if machine.target == M0 {
-            format!(
-                "≥ {:.1} % of a 48 MHz M0+",
-                push as f64 / 1000.0 * 11_520.0 / 48e6 * 100.0
-            )
-        } else {
-            "—".to_string()
-        };
-        println!(
-            "| {machine_name} | {:.1} instr/B | {:.1} instr/B | {:.1} instr/B | {:.0} instr | {load} |",
-            push as f64 / 1000.0,
-            slices as f64 / 1000.0,
-            random as f64 / 1000.0,
-            completing as f64 / 1000.0,
-        );
-        eprintln!("  ({calibration})");
+                .next()
+                .unwrap_or("?")
+                .trim_start_matches("machine: ");
+            let calibration = text
+                .lines()
+                .find(|l| l.starts_with("calibration"))
+                .unwrap_or("");
+            let push = milli("telemetry mix, push")?;
+            let slices = milli("telemetry mix, slices")?;
+            let random = milli("random bytes, push")?;
+            let completing = milli("frame-completing byte")?;
+            // 11 520 bytes a second; at one instruction a cycle (a floor: a Cortex-M0+ averages
+            // more), the share of a 48 MHz core.
+            let load = if machine.target == M0 {
+                format!(
+                    "≥ {:.1} % of a 48 MHz M0+",
+                    push as f64 / 1000.0 * 11_520.0 / 48e6 * 100.0
+                )
+            } else {
+                "—".to_string()
+            };
+            println!(
+                "| {machine_name} | {parser} | {:.1} instr/B | {:.1} instr/B | {:.1} instr/B | {:.0} instr | {load} |",
+                push as f64 / 1000.0,
+                slices as f64 / 1000.0,
+                random as f64 / 1000.0,
+                completing as f64 / 1000.0,
+            );
+            eprintln!("  ({bin}: {calibration})");
+            pushes[i] = push;
+        }
         if machine.target == M4 {
-            m4_push = Some(push / 1000);
+            m4_push = Some(IcountM4 {
+                parser_2020: pushes[0] / 1000,
+                v1: pushes[1] / 1000,
+            });
         }
     }
     let m4 = m4_push.ok_or("no Cortex-M4 figure")?;
     println!(
-        "\ngoals: ≤ 25 instr/B on the telemetry mix on Cortex-M4: {}; a saturated link under 1 % of a 48 MHz Cortex-M0+: see the last column",
-        if m4 <= 25 { "met" } else { "NOT MET" }
+        "\ngoals (2020 parser): ≤ 25 instr/B on the telemetry mix on Cortex-M4: {}; a saturated link under 1 % of a 48 MHz Cortex-M0+: see the last column",
+        if m4.parser_2020 <= 25 {
+            "met"
+        } else {
+            "NOT MET"
+        }
+    );
+    println!(
+        "ceilings on Cortex-M4, telemetry mix, `push` (regression guards): 2020 {} instr/B, {}; v1.0.0 {} instr/B, {}",
+        ICOUNT_CEILING_M4,
+        if m4.parser_2020 <= ICOUNT_CEILING_M4 {
+            "held"
+        } else {
+            "EXCEEDED"
+        },
+        ICOUNT_V1_CEILING_M4,
+        if m4.v1 <= ICOUNT_V1_CEILING_M4 {
+            "held"
+        } else {
+            "EXCEEDED"
+        }
     );
     Ok(m4)
 }
@@ -604,9 +677,16 @@ pub fn icount_table() -> Result<u64, String> {
 /// `cargo xtask icount`.
 pub fn icount() -> Result<(), String> {
     let m4 = icount_table()?;
-    if m4 > ICOUNT_CEILING_M4 {
+    if m4.parser_2020 > ICOUNT_CEILING_M4 {
         return Err(format!(
-            "{m4} instructions per byte on the Cortex-M4: past the ceiling of {ICOUNT_CEILING_M4}"
+            "{} instructions per byte on the Cortex-M4: past the ceiling of {ICOUNT_CEILING_M4}",
+            m4.parser_2020
+        ));
+    }
+    if m4.v1 > ICOUNT_V1_CEILING_M4 {
+        return Err(format!(
+            "v1.0.0 parser: {} instructions per byte on the Cortex-M4: past the ceiling of {ICOUNT_V1_CEILING_M4}",
+            m4.v1
         ));
     }
     Ok(())
