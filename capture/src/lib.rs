@@ -731,6 +731,10 @@ fn decode_v1_downlink(capture: &Capture) -> (Vec<Found>, String) {
     let (mut telemetry, mut replies) = (0u32, 0u32);
     let mut parser = v1::DownlinkParser::new();
     for (i, &byte) in capture.bytes.iter().enumerate() {
+        // A frame's bytes come back to back: none spans a quiet line in the time stamps.
+        if gap_before(capture, i).is_some() {
+            parser.quiet();
+        }
         let mut next = parser.push(byte);
         while let Some(frame) = next {
             match frame {
@@ -762,6 +766,9 @@ fn decode_v1_uplink(capture: &Capture) -> (Vec<Found>, String) {
     };
     let mut parser = v1::UplinkParser::new();
     for (i, &byte) in capture.bytes.iter().enumerate() {
+        if gap_before(capture, i).is_some() {
+            parser.quiet();
+        }
         let mut next = parser.push(byte);
         while let Some(command) = next {
             let (json, text) = describe_v1_uplink(&command);

@@ -21,7 +21,7 @@ pub mod score;
 pub use board::{Board, Gap, SentFrame, Stream};
 pub use line::{Arrived, Line, transmit};
 pub use plausible::{plausible, plausible_frame};
-pub use score::{FalseFrame, Score, Scorer, run, startup};
+pub use score::{FalseFrame, QUIET_BYTE_TIMES, Score, Scorer, run, run_reporting_quiet, startup};
 
 use crate::channel::Noise;
 

@@ -114,12 +114,45 @@ pub struct Scorer {
     /// The last received bytes and where each came from.
     window: VecDeque<(u8, Option<usize>)>,
     score: Score,
+    /// Whether the parser is told of quiet lines, as the driver tells it.
+    quiet: bool,
+    /// Idle stretches of the sent stream long enough to be a quiet line, as (offset of the
+    /// first byte after it, byte times), in the whole sent stream.
+    gaps: Vec<(usize, usize)>,
+    /// Where the last received byte that was sent came from, in the whole sent stream.
+    last_origin: Option<usize>,
 }
 
+/// A quiet line for the driver on a UART: 2 ms, 23 byte times at 115 200 bps.
+pub const QUIET_BYTE_TIMES: usize = 23;
+
 impl Scorer {
-    /// A fresh parser, nothing sent.
+    /// A fresh parser, nothing sent, told nothing of the line's timing (a capture replayed).
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A fresh parser told of every quiet line, as the driver tells it: the time between two
+    /// bytes it receives (the idle line and the bytes lost between them) of at least
+    /// [`QUIET_BYTE_TIMES`].
+    pub fn reporting_quiet() -> Self {
+        Scorer {
+            quiet: true,
+            ..Self::default()
+        }
+    }
+
+    /// Whether the time between the sent bytes `p` and `o` (whole-stream offsets, `p < o`) is
+    /// a quiet line: bytes lost between them and idle stretches before any frame in `(p, o]`.
+    fn quiet_between(&self, p: usize, o: usize) -> bool {
+        let lost = o.saturating_sub(p).saturating_sub(1);
+        let from = self.gaps.partition_point(|(at, _)| *at <= p);
+        let idle: usize = self.gaps[from..]
+            .iter()
+            .take_while(|(at, _)| *at <= o)
+            .map(|(_, t)| *t)
+            .sum();
+        lost + idle >= QUIET_BYTE_TIMES
     }
 
     /// Feeds the next block: `stream` (offsets from the block's start) as it `arrived`.
@@ -137,13 +170,26 @@ impl Scorer {
             self.score.replies += usize::from(matches!(f.frame, Downlink::Reply(_)));
         }
         self.score.sent += stream.frames.len();
+        self.gaps
+            .extend(stream.gaps.iter().map(|g| (g.offset + base, g.byte_times)));
         self.score.errors += rx.errors;
         self.score.expected_undetected += arrived.expected_undetected;
         for (byte, origin) in rx.bytes.iter().zip(&rx.origin) {
             if self.window.len() == WINDOW {
                 self.window.pop_front();
             }
-            self.window.push_back((*byte, origin.map(|o| o + base)));
+            let origin = origin.map(|o| o + base);
+            self.window.push_back((*byte, origin));
+            if let Some(o) = origin {
+                if self.quiet
+                    && self
+                        .last_origin
+                        .is_some_and(|p| p < o && self.quiet_between(p, o))
+                {
+                    self.parser.quiet();
+                }
+                self.last_origin = Some(o);
+            }
             let mut out = self.parser.push(*byte);
             while let Some(frame) = out {
                 self.judge(frame);
@@ -284,9 +330,18 @@ pub const REPLIES_PER_SECOND: f64 = 1.0;
 /// `frames` frames of a board seeded with `seed` (one reply a second) over `line` (its noise
 /// seeded with `seed ^ 0x5EED`), into one parser.
 pub fn run(line: &Line, frames: usize, seed: u64) -> Score {
+    run_with(Scorer::new(), line, frames, seed)
+}
+
+/// [`run`], the parser told of every quiet line as the driver tells it
+/// ([`Scorer::reporting_quiet`]).
+pub fn run_reporting_quiet(line: &Line, frames: usize, seed: u64) -> Score {
+    run_with(Scorer::reporting_quiet(), line, frames, seed)
+}
+
+fn run_with(mut scorer: Scorer, line: &Line, frames: usize, seed: u64) -> Score {
     let mut board = Board::new(seed, REPLIES_PER_SECOND);
     let mut rng = Pcg64Mcg::seed_from_u64(seed ^ 0x5EED);
-    let mut scorer = Scorer::new();
     let mut left = frames;
     while left > 0 {
         let n = left.min(BLOCK);

@@ -18,6 +18,10 @@
 //!   between them; one owner reports a board that never streams without these pauses), and
 //!   **confirmed** by reading it back: the write ends [`Outcome::Done`] when the readback
 //!   carries what was written, [`CoreError::ReadbackDiffers`] when it does not.
+//! * **No frame spans a quiet line**: a line quiet for [`Config::idle_ms`] (at most
+//!   [`QUIET_MAX_MS`]) is told to the
+//!   parser, which throws away the start of a frame cut short there (a run of one frame's
+//!   length lost across a boundary could otherwise join two frames under a matching BCC).
 //! * **Replies carry their code**, so a reply is matched to its request by code, and one that
 //!   nobody waits for is an [`Event::Reply`]. A reply that comes late answers the next read of
 //!   the same code with the board's state a little earlier: a readback is state, not an event,
@@ -54,6 +58,12 @@ use crate::v1::{
 /// The shortest failsafe on v1.0.0: six telemetry periods, so five frames dropped in a row
 /// never stop a healthy chassis.
 pub const MIN_FAILSAFE_MS: u32 = 300;
+
+/// The longest quiet line the core waits for before it tells its parser: [`Config::idle_ms`] or
+/// this, the shorter. v1.0.0 telemetry leaves 39–47 ms of idle line between frames (20–24 Hz), so
+/// the host's 40 ms could miss it; 25 ms is still longer than a USB-UART adapter's latency timer
+/// (16 ms), the longest gap inside a frame a PC sees.
+pub const QUIET_MAX_MS: u32 = 25;
 
 /// The least time between two settings frames (and between a settings frame and the readback
 /// that confirms it).
@@ -151,6 +161,9 @@ pub struct DriverCore {
     telemetry: Option<Stamped<Telemetry>>,
     stream: StreamInfo,
     last_settings_ms: Option<u64>,
+    /// When the last byte came, and whether the quiet since has been told to the parser.
+    last_byte_ms: Option<u64>,
+    quiet_told: bool,
 }
 
 impl DriverCore {
@@ -170,6 +183,8 @@ impl DriverCore {
             telemetry: None,
             stream: STREAM,
             last_settings_ms: None,
+            last_byte_ms: None,
+            quiet_told: false,
         }
     }
 
@@ -312,6 +327,9 @@ impl DriverCore {
     /// Feeds received bytes; the first event they complete and the bytes not yet consumed.
     pub fn receive<'a>(&mut self, bytes: &'a [u8], now_ms: u64) -> (Option<Event>, &'a [u8]) {
         let now = self.safety.advance(now_ms);
+        if !bytes.is_empty() {
+            self.byte_came(now);
+        }
         let mut rest = bytes;
         while let Some((byte, tail)) = rest.split_first() {
             rest = tail;
@@ -344,6 +362,7 @@ impl DriverCore {
                 continue;
             }
             let (&byte, _) = self.rx.pending().split_first()?;
+            self.byte_came(now);
             let left = self.rx.pending().len().saturating_sub(1);
             self.rx.left(left);
             if let Some(frame) = self.parser.push(byte) {
@@ -354,10 +373,17 @@ impl DriverCore {
         }
     }
 
-    /// Judges time: the reply timeout (retry or error) and the failsafe (a forced stop queued).
-    /// Call it once every byte the UART holds has gone through [`drain`](Self::drain).
+    /// Judges time: a quiet line (told to the parser: no frame spans one), the reply timeout
+    /// (retry or error) and the failsafe (a forced stop queued). Call it once every byte the
+    /// UART holds has gone through [`drain`](Self::drain).
     pub fn tick(&mut self, now_ms: u64) -> Option<Event> {
         let now = self.safety.advance(now_ms);
+        if let Some(last) = self.last_byte_ms {
+            if !self.quiet_told && now.saturating_sub(last) >= self.quiet_ms() {
+                self.parser.quiet();
+                self.quiet_told = true;
+            }
+        }
         if let Some(mut job) = self.job {
             if let Phase::Waiting { deadline_ms } = job.phase {
                 if now > deadline_ms {
@@ -384,7 +410,11 @@ impl DriverCore {
             Phase::Sending => None,
         });
         let failsafe = self.safety.failsafe_deadline().map(|d| d.saturating_add(1));
-        [job, failsafe].into_iter().flatten().min()
+        let quiet = match (self.last_byte_ms, self.parser.buffered()) {
+            (Some(t), 1..) if !self.quiet_told => Some(t.saturating_add(self.quiet_ms())),
+            _ => None,
+        };
+        [job, failsafe, quiet].into_iter().flatten().min()
     }
 
     /// How long from the clock reading `now_ms` until [`next_deadline`](Self::next_deadline).
@@ -450,6 +480,17 @@ impl DriverCore {
     }
 
     // ----- inside -----
+
+    /// How long a quiet line is, in ms.
+    fn quiet_ms(&self) -> u64 {
+        u64::from(self.config.idle_ms.min(QUIET_MAX_MS))
+    }
+
+    /// A byte came at `now`: the line is not quiet.
+    fn byte_came(&mut self, now: u64) {
+        self.last_byte_ms = Some(now);
+        self.quiet_told = false;
+    }
 
     /// When the settings gap ends, if one is running.
     fn gap_until(&self) -> Option<u64> {
@@ -787,5 +828,40 @@ mod tests {
         assert_eq!(out(&mut core, 0).len(), 1);
         core.stop();
         assert_eq!(out(&mut core, 1), vec![FORCED_STOP.to_vec()]);
+    }
+
+    #[test]
+    fn the_core_tells_its_parser_of_a_quiet_line() {
+        // A's first 4 bytes, then, 45 ms later, B from its byte 4: joined, the BCC matches
+        // (v1::tests::a_frame_never_spans_a_quiet_line has the bytes written out).
+        let a = Telemetry {
+            velocity: [1, 0, 0],
+            battery_mv: 12_000,
+            ..Telemetry::default()
+        }
+        .encode();
+        let b = Telemetry {
+            velocity: [256, 0, 0],
+            battery_mv: 11_900,
+            ..Telemetry::default()
+        }
+        .encode();
+        let mut core = DriverCore::new(Config::DEFAULT);
+        assert!(hear(&mut core, &a[..4], 0).is_empty());
+        assert_eq!(
+            core.next_deadline(),
+            Some(2),
+            "the quiet line is a deadline"
+        );
+        core.tick(2);
+        assert!(
+            hear(&mut core, &b[4..], 45).is_empty(),
+            "nothing made of the two"
+        );
+        assert_eq!(core.parser_stats().frames, 0);
+        // Back to back, the same bytes make a frame: the quiet line is what told them apart.
+        let mut blind = DriverCore::new(Config::DEFAULT);
+        hear(&mut blind, &a[..4], 0);
+        assert_eq!(hear(&mut blind, &b[4..], 1).len(), 1);
     }
 }

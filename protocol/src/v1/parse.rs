@@ -126,6 +126,13 @@ impl<const N: usize> Framer<N> {
         }
     }
 
+    /// The line was quiet: whatever is held is the start of a frame cut short (a frame's bytes
+    /// come back to back), never to be completed by what comes next. Thrown away, counted.
+    fn quiet(&mut self) {
+        let held = self.len;
+        self.drop_front(held);
+    }
+
     /// Forgets the `n` bytes of a frame taken (not counted as discarded).
     fn consume(&mut self, n: usize) {
         let n = n.min(self.len);
@@ -201,6 +208,17 @@ impl DownlinkParser {
     pub const fn buffered(&self) -> usize {
         self.framer.len
     }
+
+    /// The line has been quiet (no byte for longer than any gap inside a frame: 2 ms on a
+    /// UART, 40 ms behind a USB-UART adapter). A frame's bytes come back to back, so the bytes
+    /// held are the start of a frame cut short: they are thrown away (counted as discarded),
+    /// and no frame is ever made of bytes from both sides of a quiet line. Without it, a run of
+    /// exactly one frame's length lost across a frame boundary (a UART overrun) can join the
+    /// start of one frame to the end of the next with a BCC that matches
+    /// (`docs/v1-measurements.md`). Telling it is optional; the driver does.
+    pub fn quiet(&mut self) {
+        self.framer.quiet();
+    }
 }
 
 /// The master → board parser: [`Command`] frames (14 bytes), for captures and the simulator.
@@ -251,6 +269,11 @@ impl UplinkParser {
     #[must_use]
     pub const fn stats(&self) -> Stats {
         self.framer.stats
+    }
+
+    /// The line has been quiet: as [`DownlinkParser::quiet`].
+    pub fn quiet(&mut self) {
+        self.framer.quiet();
     }
 }
 

@@ -251,3 +251,37 @@ fn random_bytes_never_stick_the_parser() {
     let found: Vec<_> = parser.frames(&twice).collect();
     assert_eq!(found.last(), Some(&Downlink::decode(&frame).unwrap()));
 }
+
+/// A run of exactly one frame's length lost across a frame boundary joins the start of one
+/// telemetry frame to the end of the next, and the BCC can match (the protocol has no count or
+/// length to tell): A = velocity (1, 0, 0), 12 000 mV; B = velocity (256, 0, 0), 11 900 mV; bytes
+/// 4..36 of A then B lost. What arrives, written out: A's `7B 00 00 01`, then B from its byte 4.
+#[test]
+fn a_frame_never_spans_a_quiet_line() {
+    let joined: [u8; 32] = [
+        0x7B, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+        0x00, 0x00, 0x00, 0x00, 0x00, 0x03, 0xE8, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x2E, 0x7C,
+        0xC3, 0x7D,
+    ];
+    // Without the line's timing, the parser takes it (its rules see a good frame).
+    let mut blind = DownlinkParser::new();
+    let got: Vec<Downlink> = blind.frames(&joined).collect();
+    assert_eq!(got.len(), 1);
+    // With the quiet line reported between A's start and B's rest (45 ms apart on the wire),
+    // nothing is made of it, and the bytes are counted.
+    let mut told = DownlinkParser::new();
+    assert_eq!(told.frames(&joined[..4]).count(), 0);
+    told.quiet();
+    assert_eq!(told.buffered(), 0);
+    assert_eq!(told.frames(&joined[4..]).count(), 0);
+    assert_eq!(told.stats().frames, 0);
+    assert_eq!(told.stats().discarded, 32);
+    // A whole frame after a quiet line is taken as ever.
+    let whole = Telemetry {
+        battery_mv: 11_900,
+        ..Telemetry::default()
+    }
+    .encode();
+    told.quiet();
+    assert_eq!(told.frames(&whole).count(), 1);
+}
