@@ -3,7 +3,7 @@
 //!
 //! [`Detector`] is sans-IO: feed it what the line brings, and it says which generation the
 //! frames belong to once one has clearly more ([`Detector::verdict`]). With the `driver`
-//! feature, [`detect`] runs it on a UART: it **listens first**, and only if that does not
+//! feature, `detect()` runs it on a UART: it **listens first**, and only if that does not
 //! decide, sends two **harmless probes** ([`PROBE_2020`], [`PROBE_V1`]: a register read of each
 //! generation, never a motion, settings or action frame), then listens again.
 //!
