@@ -469,6 +469,36 @@ const PUBLISHED: [&str; 4] = [
 ///
 /// `--allow-dirty`: the package is made of the files on disk, as the rest of `test` checks them
 /// (CI's clone is clean anyway; a developer's work in progress must not fail this step).
+/// Cargo unpacks the packages it verifies the others against into `$CARGO_HOME/registry/src`,
+/// under a directory per temporary registry, and reuses what it finds there for the same name
+/// and version: an earlier run's sources. Those of our own crates are removed first.
+fn forget_unpacked_packages() -> Result<(), String> {
+    let home = std::env::var_os("CARGO_HOME")
+        .map(std::path::PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| std::path::Path::new(&h).join(".cargo")))
+        .ok_or("neither CARGO_HOME nor HOME is set")?;
+    let Ok(registries) = std::fs::read_dir(home.join("registry").join("src")) else {
+        return Ok(());
+    };
+    for registry in registries.filter_map(Result::ok) {
+        // Temporary registries are named "-<hash>"; the real ones after their host.
+        if !registry.file_name().to_string_lossy().starts_with('-') {
+            continue;
+        }
+        let Ok(crates) = std::fs::read_dir(registry.path()) else {
+            continue;
+        };
+        for unpacked in crates.filter_map(Result::ok) {
+            let name = unpacked.file_name().to_string_lossy().into_owned();
+            if PUBLISHED.iter().any(|p| name.starts_with(&format!("{p}-"))) {
+                std::fs::remove_dir_all(unpacked.path())
+                    .map_err(|e| format!("cannot remove {}: {e}", unpacked.path().display()))?;
+            }
+        }
+    }
+    Ok(())
+}
+
 fn package() -> Result<(), String> {
     let list = cargo_stdout(&[
         "package",
@@ -478,12 +508,31 @@ fn package() -> Result<(), String> {
         "-p",
         "chassis-protocol",
     ])?;
-    let mut args = vec!["package", "--quiet", "--allow-dirty"];
+    forget_unpacked_packages()?;
+    // Verified in a target directory of their own, whose builds of our crates are thrown away
+    // first: cargo takes a registry crate of the same name and version as unchanged.
+    let verify = target_dir()?.join("package-verify");
+    if let Ok(entries) = std::fs::read_dir(verify.join("debug").join(".fingerprint")) {
+        for entry in entries.filter_map(Result::ok) {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if PUBLISHED.iter().any(|p| name.starts_with(&format!("{p}-"))) {
+                let _ = std::fs::remove_dir_all(entry.path());
+            }
+        }
+    }
+    let verify = verify.to_string_lossy().into_owned();
+    let mut args = vec![
+        "package",
+        "--quiet",
+        "--allow-dirty",
+        "--target-dir",
+        &verify,
+    ];
     for name in PUBLISHED {
         args.extend(["-p", name]);
     }
     cargo(&args)?;
-    let dir = target_dir()?.join("package");
+    let dir = target_dir()?.join("package-verify").join("package");
     let newest = std::fs::read_dir(&dir)
         .map_err(|e| format!("cannot read {}: {e}", dir.display()))?
         .filter_map(Result::ok)
