@@ -1,7 +1,7 @@
 //! The decoder of `chassis decode` and of the Python package's `decode_capture`: a capture
 //! in, one JSON object per frame out (JSON Lines), in stream order, and a one-line summary.
 //!
-//! The JSON is a public contract (documented in the README): every object has `"offset"` (the
+//! The JSON is a public contract (documented in `docs/cli.md`): every object has `"offset"` (the
 //! byte offset of the frame's first byte in the input) and `"frame"`, the fields of its kind,
 //! and `"t"` (seconds) when the capture has time stamps.
 //!
