@@ -182,6 +182,7 @@ impl Detector {
 
 /// How [`detect`] ended.
 #[cfg(feature = "driver")]
+#[cfg_attr(docsrs, doc(cfg(feature = "driver")))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Detection {
@@ -198,15 +199,18 @@ pub struct Detection {
 /// How long [`detect`] listens before it probes, and again after: a 2020 board sends about 50
 /// frames in that time, a v1.0.0 board about 9.
 #[cfg(feature = "driver")]
+#[cfg_attr(docsrs, doc(cfg(feature = "driver")))]
 pub const LISTEN_MS: u64 = 400;
 
 /// Between the two probes, so that each is a frame of its own on the line.
 #[cfg(feature = "driver")]
+#[cfg_attr(docsrs, doc(cfg(feature = "driver")))]
 pub const PROBE_GAP_MS: u64 = 20;
 
 /// Polls in a row that see the clock stand still before [`detect`] gives up (a clock that never
 /// moves would otherwise hang it).
 #[cfg(feature = "driver")]
+#[cfg_attr(docsrs, doc(cfg(feature = "driver")))]
 pub const STALL_POLLS: u32 = 1_000_000;
 
 /// Finds the firmware generation of the board on `uart`: listens [`LISTEN_MS`]; if that does
@@ -217,6 +221,7 @@ pub const STALL_POLLS: u32 = 1_000_000;
 /// Run it on a driverless UART, before a driver takes it; `config.idle_ms` says how long a
 /// quiet line is (2 ms on a UART, 40 behind a USB-UART adapter).
 #[cfg(feature = "driver")]
+#[cfg_attr(docsrs, doc(cfg(feature = "driver")))]
 pub fn detect<U, C>(
     uart: &mut U,
     clock: &mut C,

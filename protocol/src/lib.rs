@@ -26,6 +26,49 @@
 //! assert!(matches!(frames[2], Downlink::Imu(Imu { seq: 2, .. })));
 //! ```
 //!
+//! The driver (feature `driver`) owns a UART and a clock; here the simulated board (feature
+//! `sim`) behind an in-memory UART, on simulated time:
+//!
+//! ```
+//! # #[cfg(all(feature = "driver", feature = "sim"))] {
+//! use chassis_protocol::driver::{Config, blocking::Driver, reg};
+//! use chassis_protocol::sim::{Board, SimClock, SimConfig, SimUart};
+//! use chassis_protocol::Velocity;
+//! use core::cell::Cell;
+//!
+//! let time = Cell::new(0);
+//! let mut driver = Driver::new(SimUart::new(Board::new(SimConfig::default()), &time), SimClock(&time), Config::DEFAULT);
+//! driver.set_velocity(Velocity::new(0, 300, 0))?;    // safe to repeat every period
+//! let volts: u16 = driver.read(reg::MotorVoltage)?;  // typed: 12.00 V
+//! assert_eq!(volts, 1_200);
+//! driver.turn_by(900)?;                               // 90°, sent once: a second is refused
+//! driver.stop()?;                                     // stops, and cancels the turn
+//! # }
+//! # Ok::<(), chassis_protocol::driver::Error<core::convert::Infallible>>(())
+//! ```
+//!
+//! On a PC or a Raspberry Pi (feature `std`), the same driver over a serial port:
+//!
+//! ```no_run
+//! # #[cfg(feature = "std")] {
+//! let mut driver = chassis_protocol::driver::host::open("/dev/ttyUSB0")?;
+//! driver.set_velocity(chassis_protocol::Velocity::new(0, 300, 0))?;
+//! # }
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! The board's newer firmware, v1.0.0, has its own frames ([`v1`]); [`detect`] tells the two
+//! apart from what a board sends.
+//!
+//! ```
+//! use chassis_protocol::v1::{BodyVelocity, Command, Readback};
+//!
+//! let forward = Command::BodyVelocity(BodyVelocity::new(0, 300, 0)).encode(); // 0.3 m/s
+//! assert_eq!((forward[0], forward[13]), (0x7B, 0x7D));
+//! let read = Command::Readback(Readback::Geometry).encode();
+//! assert_eq!(read[12], 0x7B ^ 0x34); // the BCC
+//! ```
+//!
 //! # Map
 //!
 //! | module | what |
@@ -65,10 +108,17 @@
 //! * `arbitrary`: `arbitrary::Arbitrary` for the frames, for fuzzing (values `decode` can return).
 //! * `driver`: the master-side driver, module `driver` (sans-IO core, blocking shell over
 //!   embedded-io 0.7); `nb`, `async`, `embedded-io-06`: its other shells and adapters.
-//! * `sim`: the board simulator, module `sim`; with `driver`, also an in-memory UART to it.
+//! * `sim`: the board simulator, module `sim` (both generations); with `driver`, also an
+//!   in-memory UART to it. Pulls in `heapless`.
+//!
+//! What each pulls in: `driver` embedded-io 0.7; `async` embedded-io-async 0.7,
+//! embedded-hal-async 1 and embassy-futures; `nb` embedded-hal-nb 1; `embedded-io-06`
+//! embedded-io 0.6; `std` serialport (no libudev); `defmt` defmt 1; `serde` serde (no std);
+//! `arbitrary` arbitrary 1. With no feature: no dependency at all.
 
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
+#![cfg_attr(docsrs, feature(doc_cfg))]
 #![cfg_attr(
     not(test),
     warn(
@@ -89,11 +139,13 @@ mod codes;
 pub mod command;
 pub mod detect;
 #[cfg(feature = "driver")]
+#[cfg_attr(docsrs, doc(cfg(feature = "driver")))]
 pub mod driver;
 mod error;
 pub mod parse;
 pub mod registers;
 #[cfg(feature = "sim")]
+#[cfg_attr(docsrs, doc(cfg(feature = "sim")))]
 pub mod sim;
 pub mod telemetry;
 pub mod units;

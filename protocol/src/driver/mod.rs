@@ -122,13 +122,17 @@
 //! readings more than 24.8 days apart with no call in between are not supported.
 
 #[cfg(feature = "async")]
+#[cfg_attr(docsrs, doc(cfg(feature = "async")))]
 pub mod asynch;
 pub mod blocking;
 #[cfg(feature = "std")]
+#[cfg_attr(docsrs, doc(cfg(feature = "std")))]
 pub mod host;
 #[cfg(feature = "embedded-io-06")]
+#[cfg_attr(docsrs, doc(cfg(feature = "embedded-io-06")))]
 pub mod io06;
 #[cfg(feature = "nb")]
+#[cfg_attr(docsrs, doc(cfg(feature = "nb")))]
 pub mod nb;
 mod safety;
 mod sans_io;
