@@ -150,6 +150,12 @@ impl V1DownlinkParser {
             .collect()
     }
 
+    /// The line has been quiet (2 ms on a UART, 25 ms behind a USB-UART): the start of a
+    /// frame cut short is thrown away; no frame spans a quiet line.
+    fn quiet(&mut self) {
+        self.inner.quiet();
+    }
+
     /// Counters: frames, bad_checksum, bad_end, refused, discarded.
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -181,6 +187,12 @@ impl V1UplinkParser {
             .into_iter()
             .map(|f| frames::v1_uplink(py, f))
             .collect()
+    }
+
+    /// The line has been quiet (2 ms on a UART, 25 ms behind a USB-UART): the start of a
+    /// frame cut short is thrown away; no frame spans a quiet line.
+    fn quiet(&mut self) {
+        self.inner.quiet();
     }
 
     /// Counters: frames, bad_checksum, bad_end, refused, discarded.
