@@ -261,15 +261,15 @@ fn verdict(
     lines.join("\n")
 }
 
-/// Asks before the chassis moves: `Ok(true)` to go on.
-fn confirm(path: &str) -> Result<bool, String> {
+/// Asks before the chassis moves (`motion`: what it will do): `Ok(true)` to go on.
+pub fn confirm(path: &str, motion: &str) -> Result<bool, String> {
     let stdin = std::io::stdin();
     if !stdin.is_terminal() {
         return Err(format!(
-            "{MOTION}. Nobody is at a terminal to agree: add --yes to go ahead, or --no-motion to check the link, the registers and the battery only"
+            "{motion}. Nobody is at a terminal to agree: add --yes to go ahead, or --no-motion to check the link, the registers and the battery only"
         ));
     }
-    tell_partial!("chassis check on {path}: {MOTION}.\nGo ahead? [y/N] ");
+    tell_partial!("chassis check on {path}: {motion}.\nGo ahead? [y/N] ");
     let _ = std::io::stderr().flush();
     let mut answer = String::new();
     stdin
@@ -287,7 +287,7 @@ pub fn check(
     drive: Option<DriveType>,
 ) -> Result<(), (String, u8)> {
     let failed = |e: String| (e, 1u8);
-    if !no_motion && !yes && !confirm(path).map_err(failed)? {
+    if !no_motion && !yes && !confirm(path, MOTION).map_err(failed)? {
         return Err(failed("check cancelled: nothing was sent".into()));
     }
     signals::install().map_err(failed)?;

@@ -32,6 +32,7 @@ macro_rules! tell_partial {
 }
 
 mod check;
+mod check_v1;
 mod connect;
 mod device;
 mod encode;
@@ -190,7 +191,8 @@ enum Cmd {
         speed: String,
     },
     /// Check a board end to end: the firmware's bring-up from this PC (link and rates, every
-    /// register, drive type, forward, sideways, a 90° turn, stop, battery, a control loop).
+    /// register, drive type, forward, sideways, a 90° turn, stop, battery, a control loop; on
+    /// v1.0.0: the velocity followed, a rotation at a rate, the forced stop, settings only read).
     /// Exit status 0 when every check passes, else the failed check's code (10..=18).
     Check {
         /// Only what neither moves the chassis nor writes to the board: link, registers,
@@ -200,7 +202,7 @@ enum Cmd {
         /// Do not ask before the chassis moves.
         #[arg(long)]
         yes: bool,
-        /// Set this drive type on the board (the board's own is kept if not given).
+        /// Set this drive type on the board (the board's own is kept if not given; 2020 only).
         #[arg(long, value_enum, value_name = "TYPE", conflicts_with = "no_motion")]
         drive_type: Option<DriveTypeName>,
     },
@@ -269,13 +271,16 @@ fn main() -> ExitCode {
                 if connect::generation(path, cli.firmware).map_err(|e| (e, 1))?
                     == Firmware::V1_0_0
                 {
-                    return Err((
-                        not_on_v1(
-                            "check",
-                            "the bring-up checks are the 2020 firmware's (try `chassis detect`, `chassis get system`, `chassis drive --vy 0.1 --for 1`)",
-                        ),
-                        1,
-                    ));
+                    if drive_type.is_some() {
+                        return Err((
+                            not_on_v1(
+                                "check --drive-type",
+                                "it has no drive-type register (each velocity frame carries the vendor's type byte): run `chassis check` without it",
+                            ),
+                            1,
+                        ));
+                    }
+                    return check_v1::check(path, no_motion, yes);
                 }
                 check::check(
                     path,

@@ -1,0 +1,367 @@
+//! `chassis check` on a board running the v1.0.0 firmware: its bring-up
+//! ([`chassis_bringup::v1::bring_up_v1`], the code the QEMU firmware runs against a v1.0.0
+//! board) from a PC, through the host driver. The same shape as the 2020 check: a progress line
+//! per check, a verdict on one screen, the exit status the failed check's code (the QEMU
+//! firmware's), a question before anything moves, and SIGINT, SIGTERM and SIGHUP ending the
+//! check with the forced stop sent.
+//!
+//! Nothing is written to the board: the settings are read back, never sent (the settings
+//! frames would overwrite what the owner tuned). v1.0.0 has no drive-type register and no turn
+//! by an angle: its checks are eight, the turn a rotation at a rate.
+
+use crate::check::confirm;
+use crate::device::core_words;
+use crate::port::{self, BoardV1, Port, SharedClock};
+use crate::signals;
+use chassis_bringup::link::Blocking;
+use chassis_bringup::v1::{LinkV1, ReportV1, WhyV1, bring_up_v1};
+use chassis_bringup::{Check, Failure, LinkError, Note, Plan, Skip};
+use chassis_protocol::driver::Error;
+use chassis_protocol::driver::v1::{DriverCore, Event};
+use chassis_protocol::v1::{BodyVelocity, Readback, Reply};
+use std::io::Write as _;
+use std::time::Instant;
+
+/// What the check does to a v1.0.0 chassis, said before it starts.
+const MOTION: &str = "the chassis will move: forward and sideways at 0.3 m/s for 0.4 s each, a rotation at 1 rad/s for 1.2 s (about 70°), then 1.5 s forward at 0.15 m/s. Give it about a metre of clear floor, or lift it so its wheels turn freely";
+
+/// The checks of a v1.0.0 board, in order (no drive type: no register holds one).
+const CHECKS: [Check; 8] = [
+    Check::Link,
+    Check::Settings,
+    Check::Forward,
+    Check::Strafe,
+    Check::Turn,
+    Check::Stop,
+    Check::Battery,
+    Check::ControlLoop,
+];
+
+/// A check's name on v1.0.0 (its turn is a rotation at a rate).
+const fn name(check: Check) -> &'static str {
+    match check {
+        Check::Turn => "rotation",
+        other => other.name(),
+    }
+}
+
+/// The check's [`LinkV1`]: the host driver, with a progress line per check and the signals
+/// turned into an error at the next call (the bring-up then sends the forced stop itself).
+struct CheckerV1 {
+    inner: Blocking<Port, SharedClock, DriverCore>,
+    start: Instant,
+    step: Instant,
+    /// Telemetry frames taken since the check under way started.
+    frames: u32,
+    /// The checks done: passed (`true`) or skipped.
+    done: Vec<(Check, bool)>,
+    /// How the last forced stop went (`None`: none was sent).
+    last_stop: Option<Result<(), LinkError>>,
+    /// The check under way.
+    current: Option<Check>,
+}
+
+impl CheckerV1 {
+    /// `Err` once a signal came: the bring-up fails its check and sends the forced stop.
+    fn go_on(&self) -> Result<(), LinkError> {
+        match signals::caught() {
+            Some(_) => Err(Error::Transport(embedded_io::ErrorKind::Interrupted)),
+            None => Ok(()),
+        }
+    }
+}
+
+impl LinkV1 for CheckerV1 {
+    fn now_ms(&mut self) -> u64 {
+        self.inner.now_ms()
+    }
+    fn core(&self) -> &DriverCore {
+        LinkV1::core(&self.inner)
+    }
+    fn poll(&mut self) -> Result<Option<Event>, LinkError> {
+        self.go_on()?;
+        let event = self.inner.poll()?;
+        if let Some(Event::Telemetry(_)) = event {
+            self.frames = self.frames.saturating_add(1);
+        }
+        Ok(event)
+    }
+    fn set_velocity(&mut self, velocity: BodyVelocity) -> Result<(), LinkError> {
+        self.go_on()?;
+        self.inner.set_velocity(velocity)
+    }
+    fn stop(&mut self) -> Result<(), LinkError> {
+        // Never refused: a signal is what a stop is for.
+        let result = LinkV1::stop(&mut self.inner);
+        self.last_stop = Some(result);
+        result
+    }
+    fn readback(&mut self, readback: Readback) -> Result<Reply, LinkError> {
+        self.go_on()?;
+        self.inner.readback(readback)
+    }
+    fn note(&mut self, note: Note) {
+        let index = |c: Check| CHECKS.iter().position(|x| *x == c).unwrap_or(0) + 1;
+        let mut out = std::io::stdout().lock();
+        match note {
+            Note::Start(check) => {
+                self.step = Instant::now();
+                self.frames = 0;
+                self.current = Some(check);
+                let _ = write!(out, "[{}/8] {:<13}", index(check), name(check));
+            }
+            Note::Passed(check) => {
+                let seconds = self.step.elapsed().as_secs_f64();
+                let detail = match check {
+                    Check::Link => format!("{} telemetry frames in {seconds:.1} s", self.frames),
+                    Check::Battery => LinkV1::core(&self.inner)
+                        .telemetry()
+                        .map_or_else(String::new, |t| {
+                            format!("{:.2} V", units(t.value.battery_mv.into()))
+                        }),
+                    _ => String::new(),
+                };
+                let _ = writeln!(out, "ok    {seconds:>4.1} s  {detail}");
+                self.done.push((check, true));
+                self.current = None;
+            }
+            Note::Skipped(check, why) => {
+                let _ = writeln!(
+                    out,
+                    "[{}/8] {:<13}skipped ({})",
+                    index(check),
+                    name(check),
+                    match why {
+                        Skip::NoMotion => "--no-motion",
+                        Skip::DriveTypeKept | Skip::NoSideways | Skip::NoEncoders => {
+                            "not on v1.0.0"
+                        }
+                    }
+                );
+                self.done.push((check, false));
+            }
+        }
+        let _ = out.flush();
+    }
+}
+
+/// Milli-units as units with two decimals.
+fn units(milli: i32) -> f64 {
+    f64::from(milli) / 1000.0
+}
+
+/// Why a check failed, in words.
+fn why(why: WhyV1, heard: bool, port: &str) -> String {
+    match why {
+        WhyV1::Driver(Error::Transport(embedded_io::ErrorKind::Interrupted)) => {
+            "interrupted".into()
+        }
+        WhyV1::Driver(Error::Core(e)) => core_words(e, !heard, port),
+        WhyV1::Driver(Error::Transport(kind)) => format!(
+            "the serial port failed ({kind:?}): was the adapter unplugged, or the board's power cut?"
+        ),
+        WhyV1::Driver(e) => format!("the driver failed: {e:?}"),
+        WhyV1::Rate(per_10s) if !heard => format!(
+            "no telemetry ({:.1} Hz): is the board powered, TX wired to RX and RX to TX, at 115200 bps?",
+            f64::from(per_10s) / 10.0
+        ),
+        WhyV1::Rate(per_10s) => format!(
+            "telemetry comes at {:.1} Hz, at least 14 Hz expected (the board sends 20-24 Hz)",
+            f64::from(per_10s) / 10.0
+        ),
+        WhyV1::NoTelemetry => {
+            "no telemetry frame came when one was needed: the board went quiet".into()
+        }
+        WhyV1::NotFollowed(commanded, measured) => format!(
+            "the measured velocity did not follow the command: {:.3} m/s for {:.3} m/s commanded (motors powered? wheels free?)",
+            units(measured.into()),
+            units(commanded.into())
+        ),
+        WhyV1::YawOff(expected, measured) => format!(
+            "the yaw from the IMU turned {:.2} rad, {:.2} rad expected (is the chassis free to turn, the IMU fixed to it?)",
+            units(measured),
+            units(expected)
+        ),
+        WhyV1::StillMoving([vx, vy, wz]) => format!(
+            "still moving after the forced stop: |vx| {:.3} m/s, |vy| {:.3} m/s, |wz| {:.3} rad/s",
+            units(vx.into()),
+            units(vy.into()),
+            units(wz.into())
+        ),
+        WhyV1::LowBattery(mv, cutoff) => format!(
+            "the battery is at {:.2} V, its cut-off {:.2} V: charge it",
+            units(mv.into()),
+            units(cutoff.into())
+        ),
+        WhyV1::FailsafeStop => {
+            "the board went quiet: the driver's failsafe sent the forced stop".into()
+        }
+    }
+}
+
+/// The verdict of a passed check, one line per check.
+fn verdict(report: &ReportV1, done: &[(Check, bool)], motion: bool, seconds: f64) -> String {
+    let passed = done.iter().filter(|(_, p)| *p).count();
+    let skipped = done.len() - passed;
+    let mut lines = vec![format!(
+        "PASS: {passed} checks passed{} in {seconds:.1} s (firmware v1.0.0)",
+        if skipped > 0 {
+            format!(", {skipped} skipped")
+        } else {
+            String::new()
+        }
+    )];
+    let (system, geometry, pid) = (&report.system, &report.geometry, &report.pid);
+    for (check, passed) in done {
+        let detail = match (check, passed) {
+            (_, false) => "skipped".to_string(),
+            (Check::Link, _) => format!(
+                "telemetry {:.1} Hz",
+                f64::from(report.telemetry_per_10s) / 10.0
+            ),
+            (Check::Settings, _) => format!(
+                "read back, nothing written: wheel diameter {} mm, wheel spacing {} mm, axle spacing {} mm, gear ratio {}, encoder {} PPR, PWM {}..{}, velocity PI {}/{}",
+                geometry.wheel_diameter_mm,
+                geometry.wheel_spacing_mm,
+                geometry.axle_spacing_mm,
+                geometry.gear_ratio,
+                system.encoder_ppr,
+                system.pwm_min,
+                system.pwm_max,
+                pid.velocity_kp,
+                pid.velocity_ki
+            ),
+            (Check::Forward, _) => format!(
+                "vy measured {:.3} m/s",
+                units(report.measured_mm_s[0].into())
+            ),
+            (Check::Strafe, _) => format!(
+                "vx measured {:.3} m/s",
+                units(report.measured_mm_s[1].into())
+            ),
+            (Check::Turn, _) => format!(
+                "yaw turned {:.2} rad ({:.2} expected), gyro z peak {} (raw)",
+                units(report.yaw_measured_mrad),
+                units(report.yaw_expected_mrad),
+                report.gyro_z_peak
+            ),
+            (Check::Stop, _) => format!(
+                "still after the forced stop (peaks |vx| {} |vy| {} mm/s, |wz| {} mrad/s)",
+                report.still_peak[0], report.still_peak[1], report.still_peak[2]
+            ),
+            (Check::Battery, _) => format!("{:.2} V", units(report.battery_mv.into())),
+            (Check::ControlLoop, _) => format!(
+                "telemetry {:.1} Hz while commanded, no failsafe stop",
+                f64::from(report.loop_per_10s) / 10.0
+            ),
+            (Check::DriveType, _) => "not on v1.0.0".into(),
+        };
+        lines.push(format!("  {:<13} {detail}", name(*check)));
+    }
+    lines.push(format!(
+        "  frames refused by the parser: {}; {}",
+        report.bad_frames,
+        if motion {
+            "the chassis is stopped (forced stop)"
+        } else {
+            "nothing moved, nothing was written"
+        }
+    ));
+    lines.join("\n")
+}
+
+/// `chassis check [--no-motion] [--yes]` on a v1.0.0 board.
+pub fn check(path: &str, no_motion: bool, yes: bool) -> Result<(), (String, u8)> {
+    let failed = |e: String| (e, 1u8);
+    if !no_motion && !yes && !confirm(path, MOTION).map_err(failed)? {
+        return Err(failed("check cancelled: nothing was sent".into()));
+    }
+    signals::install().map_err(failed)?;
+    let board: BoardV1 = port::open_v1(path, None).map_err(failed)?;
+    let (uart, clock, core) = board.release();
+    let reader = clock.detached();
+    let driver = BoardV1::from_core(uart, clock, core);
+    let mut link = CheckerV1 {
+        inner: Blocking::from_driver(driver, reader),
+        start: Instant::now(),
+        step: Instant::now(),
+        frames: 0,
+        done: Vec::new(),
+        last_stop: None,
+        current: None,
+    };
+    say!(
+        "chassis check on {path} (firmware v1.0.0): {}",
+        if no_motion {
+            "link, settings and battery (only readbacks are sent: nothing moves, nothing is written)"
+        } else {
+            "every check (the chassis moves; nothing is written)"
+        }
+    );
+    let plan = Plan {
+        drive: None,
+        motion: !no_motion,
+        ..Plan::DEFAULT
+    };
+    let result = bring_up_v1(&mut link, &plan);
+    let seconds = link.start.elapsed().as_secs_f64();
+    let failure = match result {
+        Ok(report) => {
+            say!("\n{}", verdict(&report, &link.done, !no_motion, seconds));
+            return Ok(());
+        }
+        Err(failure) => failure,
+    };
+    let interrupted = signals::caught();
+    if link.current.is_some() {
+        say!(
+            "{}",
+            if interrupted.is_some() {
+                "interrupted"
+            } else {
+                "FAILED"
+            }
+        );
+    }
+    let heard = LinkV1::core(&link).last_heard_ms().is_some();
+    let code = u8::try_from(failure.check.exit_code()).unwrap_or(1);
+    let not_run: Vec<&str> = CHECKS
+        .iter()
+        .filter(|c| !link.done.iter().any(|(d, _)| d == *c) && **c != failure.check)
+        .filter(|c| !no_motion || !c.moves())
+        .map(|c| name(*c))
+        .collect();
+    let tail = if not_run.is_empty() {
+        String::new()
+    } else {
+        format!("; not run: {}", not_run.join(", "))
+    };
+    let stopped = match (&link.last_stop, no_motion) {
+        (_, true) => String::new(),
+        (Some(Ok(())), false) => "; the chassis was stopped (forced stop)".into(),
+        (Some(Err(e)), false) => format!(
+            "; the forced stop could not be sent ({}): the chassis may still be moving, cut its power",
+            why(WhyV1::Driver(*e), heard, path)
+        ),
+        (None, false) => "; nothing had moved".into(),
+    };
+    let Failure { check, why: reason } = failure;
+    Err(match interrupted {
+        Some(signal) => (
+            format!(
+                "interrupted by {} during the {} check{stopped}{tail}",
+                signals::name(signal),
+                name(check)
+            ),
+            signals::exit_status(signal),
+        ),
+        None => (
+            format!(
+                "FAIL: {}: {}{stopped}{tail}",
+                name(check),
+                why(reason, heard, path)
+            ),
+            code,
+        ),
+    })
+}
