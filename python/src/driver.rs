@@ -9,7 +9,7 @@ use crate::frames;
 use chassis_protocol as p;
 use chassis_protocol::detect::{self, Firmware};
 use chassis_protocol::driver::blocking::Driver;
-use chassis_protocol::driver::host::{MonotonicClock, SerialError, SerialPort};
+use chassis_protocol::driver::host::{MonotonicClock, SerialError, SerialPort, WAIT_FOR_BYTE};
 use chassis_protocol::driver::{
     Config, Core, DriverCore, Error, Event, Outcome, Request, TurnState, v1,
 };
@@ -208,6 +208,9 @@ fn pump<K: Core>(state: &Mutex<State<K>>, running: &AtomicBool, clock: Monotonic
             let Some(driver) = st.driver.as_mut() else {
                 return;
             };
+            // Take in what arrived without waiting for more: the pump paces itself, and a
+            // wait inside the driver would be a second sleep (and the lock held) every round.
+            let _ = driver.uart_mut().set_wait_for_byte(Duration::ZERO);
             for _ in 0..64 {
                 match driver.poll() {
                     Ok(Some(event)) => {
@@ -227,6 +230,7 @@ fn pump<K: Core>(state: &Mutex<State<K>>, running: &AtomicBool, clock: Monotonic
                     }
                 }
             }
+            let _ = driver.uart_mut().set_wait_for_byte(WAIT_FOR_BYTE);
             let mut now = clock;
             if let Some(ms) = driver.core().wait_ms(now.now_ms()) {
                 nap = nap.min(Duration::from_millis(ms.max(1)));

@@ -99,6 +99,15 @@ impl SerialPort {
         Ok(SerialPort { port, held: None })
     }
 
+    /// How long [`ReadReady::read_ready`](embedded_io::ReadReady::read_ready) waits for a first
+    /// byte before it says none is there ([`WAIT_FOR_BYTE`] unless set). A loop that paces
+    /// itself (a thread woken by a timer) sets [`Duration::ZERO`]: it then takes in what
+    /// arrived and returns at once, never sleeping inside the driver. Costs no system call.
+    pub fn set_wait_for_byte(&mut self, wait: Duration) -> Result<(), SerialError> {
+        self.port.set_timeout(wait)?;
+        Ok(())
+    }
+
     /// The port's name, as the OS gives it.
     #[must_use]
     pub fn name(&self) -> Option<String> {
