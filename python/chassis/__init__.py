@@ -53,6 +53,7 @@ from .chassis_native import (
     __version__,
     decode_capture,
 )
+from .chassis_native import _interpreter_exiting
 from .chassis_native import open as _open
 
 __all__ = [
@@ -170,3 +171,6 @@ def _stop_all() -> None:
             bot.close()
         except ChassisError:
             pass
+    # Other threads still in a blocking call of this package stay there (see `detach` in the
+    # native module): CPython before 3.14 would end them in a way that aborts the process.
+    _interpreter_exiting()

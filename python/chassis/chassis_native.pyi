@@ -9,6 +9,7 @@ __version__: str
 
 __all__ = [
     "__version__",
+    "_interpreter_exiting",
     "Action",
     "Battery",
     "Board",
@@ -45,6 +46,9 @@ __all__ = [
 ]
 
 # ----- exceptions -----
+
+# Called by `chassis` at interpreter exit, once every chassis is stopped and closed.
+def _interpreter_exiting() -> None: ...
 
 class ChassisError(Exception): ...
 class TimeoutError(ChassisError): ...

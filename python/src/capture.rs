@@ -90,7 +90,7 @@ pub fn decode_capture(
         }
     }
     let quiet_s = quiet_ms.map(|q| q / 1000.0);
-    let decoded = py.detach(|| -> Result<decode::Decoded, String> {
+    let decoded = crate::detach(py, || -> Result<decode::Decoded, String> {
         let mut capture = decode::read_capture(&data, input)?;
         capture.quiet_s = quiet_s;
         match master.as_deref() {

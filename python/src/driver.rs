@@ -47,7 +47,9 @@ pub struct Link<K: Core> {
     /// A copy of the driver's clock (the same origin).
     clock: MonotonicClock,
     running: Arc<AtomicBool>,
-    pump: Option<JoinHandle<()>>,
+    /// The pump thread, taken (and joined) by whoever closes first: `close` takes `&self`, so
+    /// a chassis in use by another thread still closes.
+    pump: Mutex<Option<JoinHandle<()>>>,
     /// The port's path.
     pub port: String,
 }
@@ -106,7 +108,7 @@ where
             state,
             clock,
             running,
-            pump,
+            pump: Mutex::new(pump),
             port,
         }
     }
@@ -119,7 +121,7 @@ where
         + Send,
     ) -> PyResult<R> {
         let port = self.port.as_str();
-        py.detach(|| {
+        crate::detach(py, || {
             let mut state = lock(&self.state);
             let Some(driver) = state.driver.as_mut() else {
                 return Err(closed(port));
@@ -162,8 +164,9 @@ where
         lock(&self.state).overflowed
     }
 
-    /// Stops the chassis (best effort), ends the pump and closes the port.
-    pub fn close(&mut self, py: Python<'_>) -> PyResult<()> {
+    /// Stops the chassis (best effort), ends the pump and closes the port. A call of another
+    /// thread in progress ends first (each is bounded), then the stop goes out.
+    pub fn close(&self, py: Python<'_>) -> PyResult<()> {
         let result = self.with(py, |d| d.stop());
         self.shut();
         match result {
@@ -173,9 +176,14 @@ where
     }
 
     /// Ends the pump thread and drops the driver (no I/O).
-    fn shut(&mut self) {
+    fn shut(&self) {
         self.running.store(false, Ordering::SeqCst);
-        if let Some(t) = self.pump.take() {
+        let pump = self
+            .pump
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .take();
+        if let Some(t) = pump {
             let _ = t.join();
         }
         lock(&self.state).driver = None;
@@ -186,7 +194,12 @@ impl<K: Core> Drop for Link<K> {
     fn drop(&mut self) {
         // Collected without `close()`: stop the chassis before the port goes.
         self.running.store(false, Ordering::SeqCst);
-        if let Some(t) = self.pump.take() {
+        let pump = self
+            .pump
+            .get_mut()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .take();
+        if let Some(t) = pump {
             let _ = t.join();
         }
         let mut state = lock(&self.state);
@@ -298,10 +311,9 @@ pub fn open(
     let config = config(failsafe_ms, board_latency_ms, idle_ms, read_tries);
     let given = firmware.map(firmware_of).transpose()?;
     let path = port.to_string();
-    let opened = py.detach(|| -> Result<(SerialPort, Firmware), PyErr> {
-        let mut serial = SerialPort::open(&path).map_err(|e| {
-            errors::TransportError::new_err(format!("cannot open {path}: {}", e.0))
-        })?;
+    let opened = crate::detach(py, || -> Result<(SerialPort, Firmware), PyErr> {
+        let mut serial = SerialPort::open(&path)
+            .map_err(|e| errors::TransportError::new_err(format!("cannot open {path}: {}", e.0)))?;
         let firmware = match given {
             Some(f) => f,
             None => {
@@ -352,6 +364,20 @@ pub fn open(
     })
 }
 
+/// When a wait of `timeout` seconds ends: `None` (no end) for `None`, infinity or a wait too
+/// long to count; `ValueError` for a negative number or NaN.
+fn deadline(timeout: Option<f64>) -> PyResult<Option<Instant>> {
+    match timeout {
+        None => Ok(None),
+        Some(t) if t.is_nan() || t < 0.0 => Err(PyValueError::new_err(format!(
+            "timeout = {t}: a number of seconds, 0 or more (None or math.inf waits for ever)"
+        ))),
+        Some(t) => Ok(Duration::try_from_secs_f64(t)
+            .ok()
+            .and_then(|d| Instant::now().checked_add(d))),
+    }
+}
+
 /// Waits until `until` or a frame, polling the queue, the GIL released between looks and
 /// signals checked (Ctrl-C raises `KeyboardInterrupt`).
 fn wait_event<K>(link: &Link<K>, py: Python<'_>, timeout: Option<f64>) -> PyResult<Option<K::Event>>
@@ -359,7 +385,7 @@ where
     K: Core + Heard + Send + 'static,
     K::Event: Send,
 {
-    let end = timeout.map(|t| Instant::now() + Duration::from_secs_f64(t.max(0.0)));
+    let end = deadline(timeout)?;
     loop {
         if let Some(e) = link.next_event()? {
             return Ok(Some(e));
@@ -368,7 +394,7 @@ where
             return Ok(None);
         }
         py.check_signals()?;
-        py.detach(|| std::thread::sleep(Duration::from_millis(2)));
+        crate::detach(py, || std::thread::sleep(Duration::from_millis(2)));
     }
 }
 
@@ -436,14 +462,16 @@ impl Chassis {
         self.link.with(py, |d| d.set_velocity(v))
     }
 
-    /// Drives each motor: closed-loop speeds, or open-loop duty in 0.01 % (`open_loop=True`).
+    /// Drives each motor: closed-loop speeds (±65535), or open-loop duty in 0.01 % (±10000,
+    /// `open_loop=True`). A value out of range is a `ValueError`, nothing sent.
     #[pyo3(signature = (values, open_loop = false))]
-    fn set_motors(&self, py: Python<'_>, values: [i32; 4], open_loop: bool) -> PyResult<()> {
-        let m = if open_loop {
-            p::Motors::open_loop_duty(values)
-        } else {
-            p::Motors::closed_loop(values)
-        };
+    fn set_motors(
+        &self,
+        py: Python<'_>,
+        values: [Bound<'_, PyAny>; 4],
+        open_loop: bool,
+    ) -> PyResult<()> {
+        let m = frames::Motors::new_checked(frames::ints(values, "values")?, open_loop)?.inner();
         self.link.with(py, |d| d.set_motors(m))
     }
 
@@ -484,10 +512,11 @@ impl Chassis {
     }
 
     /// Waits until the turn is done (the pending angle reads 0): `True`, or `False` after
-    /// `timeout` seconds. `KeyboardInterrupt` while waiting cancels the turn.
+    /// `timeout` seconds (`None` or `math.inf`: for ever; negative or NaN: `ValueError`).
+    /// `KeyboardInterrupt` while waiting cancels the turn.
     #[pyo3(signature = (timeout = None))]
     fn wait_turn(&self, py: Python<'_>, timeout: Option<f64>) -> PyResult<bool> {
-        let end = timeout.map(|t| Instant::now() + Duration::from_secs_f64(t.max(0.0)));
+        let end = deadline(timeout)?;
         loop {
             if !self.link.core(DriverCore::turning)? {
                 return Ok(true);
@@ -499,7 +528,7 @@ impl Chassis {
                 let _ = self.link.with(py, |d| d.stop());
                 return Err(e);
             }
-            py.detach(|| std::thread::sleep(Duration::from_millis(100)));
+            crate::detach(py, || std::thread::sleep(Duration::from_millis(100)));
             // One lost reply is no reason to give up: the timeout bounds the wait.
             let _ = self.link.with(py, |d| d.turn_remaining());
         }
@@ -616,11 +645,11 @@ impl Chassis {
         }
     }
 
-    /// Waits up to `timeout` seconds (`None`: for ever) for the next telemetry frame; `None`
-    /// if none came.
+    /// Waits up to `timeout` seconds (`None` or `math.inf`: for ever; negative or NaN:
+    /// `ValueError`) for the next telemetry frame; `None` if none came.
     #[pyo3(signature = (timeout = None))]
     fn wait_frame(&self, py: Python<'_>, timeout: Option<f64>) -> PyResult<Option<Py<PyAny>>> {
-        let end = timeout.map(|t| Instant::now() + Duration::from_secs_f64(t.max(0.0)));
+        let end = deadline(timeout)?;
         loop {
             let left = end.map(|end| end.saturating_duration_since(Instant::now()).as_secs_f64());
             match wait_event(&self.link, py, left)? {
@@ -709,7 +738,7 @@ impl Chassis {
     }
 
     /// Stops the chassis and closes the port (again: nothing).
-    fn close(&mut self, py: Python<'_>) -> PyResult<()> {
+    fn close(&self, py: Python<'_>) -> PyResult<()> {
         self.link.close(py)
     }
 
@@ -719,7 +748,7 @@ impl Chassis {
 
     /// Stops the chassis and closes the port; an exception in the block goes on.
     fn __exit__(
-        &mut self,
+        &self,
         py: Python<'_>,
         exc_type: Option<Bound<'_, PyAny>>,
         exc_value: Option<Bound<'_, PyAny>>,
@@ -871,9 +900,22 @@ impl ChassisV1 {
         self.link.with(py, |d| d.set_velocity(v))
     }
 
-    /// Drives each motor (`0x26`; the board's own unit, raw).
-    fn set_motors(&self, py: Python<'_>, speeds: [i16; 4]) -> PyResult<()> {
-        let m = p::v1::MotorVelocity::new(speeds);
+    /// Drives each motor (`0x26`; the board's own unit, raw, each -32768..=32767: out of range
+    /// is a `ValueError`, nothing sent).
+    fn set_motors(&self, py: Python<'_>, speeds: [Bound<'_, PyAny>; 4]) -> PyResult<()> {
+        let mut raw = [0i16; 4];
+        for (i, (out, v)) in raw
+            .iter_mut()
+            .zip(frames::ints(speeds, "speeds")?)
+            .enumerate()
+        {
+            *out = i16::try_from(v).map_err(|_| {
+                PyValueError::new_err(format!(
+                    "speeds[{i}] = {v} is out of range (-32768..=32767, the frame's 16 bits)"
+                ))
+            })?;
+        }
+        let m = p::v1::MotorVelocity::new(raw);
         self.link.with(py, |d| d.set_motors(m))
     }
 
@@ -982,7 +1024,8 @@ impl ChassisV1 {
         }
     }
 
-    /// Waits up to `timeout` seconds (`None`: for ever) for the next frame.
+    /// Waits up to `timeout` seconds (`None` or `math.inf`: for ever; negative or NaN:
+    /// `ValueError`) for the next frame.
     #[pyo3(signature = (timeout = None))]
     fn wait_frame(&self, py: Python<'_>, timeout: Option<f64>) -> PyResult<Option<Py<PyAny>>> {
         match wait_event(&self.link, py, timeout)? {
@@ -1066,7 +1109,7 @@ impl ChassisV1 {
     }
 
     /// Sends the forced stop and closes the port (again: nothing).
-    fn close(&mut self, py: Python<'_>) -> PyResult<()> {
+    fn close(&self, py: Python<'_>) -> PyResult<()> {
         self.link.close(py)
     }
 
@@ -1076,7 +1119,7 @@ impl ChassisV1 {
 
     /// Sends the forced stop and closes the port; an exception in the block goes on.
     fn __exit__(
-        &mut self,
+        &self,
         py: Python<'_>,
         exc_type: Option<Bound<'_, PyAny>>,
         exc_value: Option<Bound<'_, PyAny>>,

@@ -151,8 +151,8 @@ pub struct Motors {
 impl Motors {
     #[new]
     #[pyo3(signature = (values, open_loop = false))]
-    fn new(values: [i32; 4], open_loop: bool) -> Self {
-        Motors { values, open_loop }
+    fn new(values: [Bound<'_, PyAny>; 4], open_loop: bool) -> PyResult<Self> {
+        Self::new_checked(ints(values, "values")?, open_loop)
     }
 
     /// The frame's 12 bytes.
@@ -179,7 +179,44 @@ impl Motors {
     }
 }
 
+/// Python ints as `i64`, one too large for it a `ValueError` (out of range), not an
+/// `OverflowError`; anything but an int a `TypeError`.
+pub fn ints<const N: usize>(values: [Bound<'_, PyAny>; N], what: &str) -> PyResult<[i64; N]> {
+    let mut out = [0i64; N];
+    for (i, (o, v)) in out.iter_mut().zip(values).enumerate() {
+        *o = v.extract::<i64>().map_err(|e| {
+            if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(v.py()) {
+                pyo3::exceptions::PyValueError::new_err(format!(
+                    "{what}[{i}] = {v} is out of range"
+                ))
+            } else {
+                e
+            }
+        })?;
+    }
+    Ok(out)
+}
+
 impl Motors {
+    /// Each value range-checked (`ValueError`): speeds ±65535, duty ±10000 (0.01 %).
+    pub fn new_checked(values: [i64; 4], open_loop: bool) -> PyResult<Self> {
+        let limit: i64 = if open_loop { 10_000 } else { 65_535 };
+        let mut checked = [0i32; 4];
+        for (i, (out, v)) in checked.iter_mut().zip(values).enumerate() {
+            if !(-limit..=limit).contains(&v) {
+                return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                    "values[{i}] = {v} is out of range (±{limit}{})",
+                    if open_loop { ", duty in 0.01 %" } else { "" }
+                )));
+            }
+            *out = v as i32;
+        }
+        Ok(Motors {
+            values: checked,
+            open_loop,
+        })
+    }
+
     /// The crate's motors frame.
     pub fn inner(&self) -> p::Motors {
         if self.open_loop {

@@ -27,7 +27,7 @@ impl DownlinkParser {
 
     /// Takes bytes; the frames they complete, in order (`Imu`, `Encoders`, `Battery`, `Reply`).
     fn feed(&mut self, py: Python<'_>, data: PyBackedBytes) -> PyResult<Vec<Py<PyAny>>> {
-        let found: Vec<p::Downlink> = py.detach(|| self.inner.frames(&data).collect());
+        let found: Vec<p::Downlink> = crate::detach(py, || self.inner.frames(&data).collect());
         found.into_iter().map(|f| frames::downlink(py, f)).collect()
     }
 
@@ -91,7 +91,7 @@ impl UplinkParser {
     /// Takes bytes; the commands they complete (`Velocity`, `Turn`, `Motors`, `Read`, `Write`,
     /// `Action`).
     fn feed(&mut self, py: Python<'_>, data: PyBackedBytes) -> PyResult<Vec<Py<PyAny>>> {
-        let found: Vec<p::Command> = py.detach(|| self.inner.frames(&data).collect());
+        let found: Vec<p::Command> = crate::detach(py, || self.inner.frames(&data).collect());
         found.into_iter().map(|f| frames::uplink(py, f)).collect()
     }
 
@@ -143,7 +143,7 @@ impl V1DownlinkParser {
     /// Takes bytes; the frames they complete.
     fn feed(&mut self, py: Python<'_>, data: PyBackedBytes) -> PyResult<Vec<Py<PyAny>>> {
         use v1::Parser as _;
-        let found: Vec<v1::Downlink> = py.detach(|| self.inner.frames(&data).collect());
+        let found: Vec<v1::Downlink> = crate::detach(py, || self.inner.frames(&data).collect());
         found
             .into_iter()
             .map(|f| frames::v1_downlink(py, f))
@@ -182,7 +182,7 @@ impl V1UplinkParser {
     /// Takes bytes; the commands they complete.
     fn feed(&mut self, py: Python<'_>, data: PyBackedBytes) -> PyResult<Vec<Py<PyAny>>> {
         use v1::Parser as _;
-        let found: Vec<v1::Command> = py.detach(|| self.inner.frames(&data).collect());
+        let found: Vec<v1::Command> = crate::detach(py, || self.inner.frames(&data).collect());
         found
             .into_iter()
             .map(|f| frames::v1_uplink(py, f))

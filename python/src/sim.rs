@@ -196,7 +196,7 @@ impl SimPty {
     fn close(&mut self, py: Python<'_>) {
         self.stop.store(true, Ordering::SeqCst);
         if let Some(t) = self.thread.take() {
-            py.detach(|| {
+            crate::detach(py, || {
                 let _ = t.join();
             });
         }

@@ -167,3 +167,39 @@ def test_an_in_process_board_answers_a_read() -> None:
         replies += [f for f in parser.feed(board.transmit()) if isinstance(f, chassis.Reply)]
     replies += [f for f in parser.quiet(5) if isinstance(f, chassis.Reply)]
     assert replies == [chassis.Reply.decode(bytes.fromhex("23 0B 00 00 04 B0"))]
+
+
+def test_bad_values_are_value_errors_with_nothing_sent(board: chassis.sim.Pty, v1_board: chassis.sim.Pty) -> None:
+    # Out of range: refused, not clamped (the frame classes and the drivers alike).
+    with pytest.raises(ValueError, match="out of range"):
+        chassis.Motors([10**6, 2, 3, 4])
+    with pytest.raises(ValueError, match="out of range"):
+        chassis.Motors([10_001, 0, 0, 0], open_loop=True)
+    # The limit itself is a frame (table 1D, mode 0x02: MOTO1 = 65535 big-endian, dir 00).
+    assert chassis.Motors([65_535, 0, 0, 0]).encode() == bytes.fromhex("FF FE 02 FF FF 00 00 00 00 00 00 00")
+    with chassis.open(board.path, firmware="2020") as bot:
+        before = len(board.received)
+        for call in (
+            lambda: bot.set_motors([10**6, 2, 3, 4]),
+            lambda: bot.set_motors([10**20, 0, 0, 0]),
+            lambda: bot.set_motors([-10_001, 0, 0, 0], open_loop=True),
+            lambda: bot.wait_frame(-1),
+            lambda: bot.wait_frame(float("nan")),
+            lambda: bot.wait_turn(-1),
+            lambda: bot.wait_turn(float("nan")),
+        ):
+            with pytest.raises(ValueError):
+                call()
+        assert len(board.received) == before
+        # An infinite or huge timeout waits (for ever): a frame comes.
+        assert bot.wait_frame(float("inf")) is not None
+        assert bot.wait_frame(1e300) is not None
+        assert bot.wait_turn(float("inf")) is True  # no turn outstanding
+    with chassis.open(v1_board.path, firmware="v1.0.0") as v1:
+        before = len(v1_board.received)
+        with pytest.raises(ValueError, match="out of range"):
+            v1.set_motors([40_000, 0, 0, 0])
+        with pytest.raises(ValueError):
+            v1.wait_frame(-0.5)
+        assert len(v1_board.received) == before
+        assert v1.wait_frame(float("inf")) is not None

@@ -166,3 +166,77 @@ def test_v1_forced_stop_on_exit_and_on_a_silent_board(v1_board: chassis.sim.Pty)
         v1_board.silent = False
         bot.set_velocity(0, 0.3, 0)
     assert v1_board.received.endswith(FORCED_STOP)
+
+
+READER_THREAD = """
+    import sys, threading, time, chassis
+    bot = chassis.open(sys.argv[1], firmware=sys.argv[2])
+    threading.Thread(target=lambda: [f for f in bot], daemon=True).start()
+    bot.set_velocity(0, {speed}, 0)
+    print("driving", flush=True)
+    time.sleep(0.3)
+    # The program ends with the reader thread still waiting for frames.
+"""
+
+
+@pytest.mark.parametrize("firmware", ["2020", "v1.0.0"])
+def test_a_program_ending_with_a_thread_still_reading_stops_the_chassis_and_exits_cleanly(
+    board: chassis.sim.Pty, v1_board: chassis.sim.Pty, firmware: str
+) -> None:
+    target, speed, forward, stop = (
+        (board, 300, FORWARD, STOP) if firmware == "2020" else (v1_board, 0.3, V1_FORWARD, FORCED_STOP)
+    )
+    p = subprocess.Popen(
+        [sys.executable, "-c", textwrap.dedent(READER_THREAD.format(speed=speed)), target.path, firmware],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    out, err = p.communicate(timeout=20)
+    assert out == b"driving\n"
+    assert p.returncode == 0, err.decode()
+    assert b"Error" not in err and b"FATAL" not in err, err.decode()
+    assert forward in target.received
+    assert target.received.endswith(stop), target.received[-28:].hex(" ")
+
+
+def test_leaving_the_with_block_while_another_thread_reads_stops_the_chassis(board: chassis.sim.Pty) -> None:
+    ended = threading.Event()
+    seen: list[object] = []
+
+    def reader(bot: chassis.Chassis) -> None:
+        for frame in bot:
+            seen.append(frame)
+        ended.set()
+
+    with chassis.open(board.path, firmware="2020") as bot:
+        threading.Thread(target=reader, args=(bot,), daemon=True).start()
+        bot.set_velocity(0, 300, 0)
+        wait_until("driving", lambda: FORWARD in board.received)
+        wait_until("frames read", lambda: len(seen) > 5)
+    assert frames_2020(board.received)[-1] == STOP
+    assert ended.wait(2.0), "the reader's iteration ends when the chassis is closed"
+    with pytest.raises(chassis.ChassisError, match="is closed"):
+        bot.moving
+
+
+def test_close_from_another_thread_while_one_waits_for_a_frame(v1_board: chassis.sim.Pty) -> None:
+    bot = chassis.open(v1_board.path, firmware="v1.0.0")
+    bot.set_velocity(0, 0.3, 0)
+    wait_until("driving", lambda: V1_FORWARD in v1_board.received)
+    errors: list[BaseException] = []
+
+    def waiter() -> None:
+        try:
+            while bot.wait_frame(5.0) is not None:
+                pass
+        except chassis.ChassisError as e:
+            errors.append(e)
+
+    t = threading.Thread(target=waiter)
+    t.start()
+    time.sleep(0.1)
+    bot.close()
+    t.join(5.0)
+    assert not t.is_alive()
+    assert v1_board.received.endswith(FORCED_STOP)
+    assert [str(e) for e in errors] == [f"the chassis on {v1_board.path} is closed"]
