@@ -195,6 +195,8 @@ pub fn settings(port: &str, save: Option<&str>, restore: Option<&str>) -> Result
         let text = std::fs::read_to_string(file).map_err(|e| format!("cannot read {file}: {e}"))?;
         let snapshot: Snapshot =
             serde_json::from_str(&text).map_err(|e| format!("{file}: not a settings file: {e}"))?;
+        chassis_protocol::driver::host::check_settings(&snapshot)
+            .map_err(|e| format!("{file}: {e}; nothing was written"))?;
         let mut driver = open(port)?;
         driver
             .restore_settings(&snapshot)

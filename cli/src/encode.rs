@@ -147,18 +147,12 @@ pub fn write_of(
         };
         let full = parse_u32(value, "full", 0, u32::from(u16::MAX))?;
         let cut = parse_u32(cutoff, "cutoff", 0, u32::from(u16::MAX))?;
-        // 0x7FFF is the built-in table, for either.
-        if full != 0x7FFF && cut != 0x7FFF && full <= cut {
-            return Err(format!(
-                "battery-range: full {:.2} V is not above cut-off {:.2} V (FULL comes first)",
-                f64::from(full) / 100.0,
-                f64::from(cut) / 100.0
-            ));
-        }
-        return Ok(Write::BatteryRange {
+        let write = Write::BatteryRange {
             full_centivolts: full as u16,
             cutoff_centivolts: cut as u16,
-        });
+        };
+        chassis_protocol::driver::host::check_write(write)?;
+        return Ok(write);
     }
     if cutoff.is_some() {
         return Err(format!("{name} takes one value"));

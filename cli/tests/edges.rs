@@ -237,6 +237,29 @@ fn a_restore_says_what_it_did_not_restore() {
 }
 
 #[test]
+fn a_restore_is_checked_as_set_is_before_anything_is_written() {
+    let board = TestBoard::start();
+    let file = std::env::temp_dir().join(format!("chassis-inverted-{}.json", std::process::id()));
+    let file = file.to_string_lossy().into_owned();
+    let out = board.run(&["settings", "--save", &file]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let mut saved: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    // Full 10.00 V below the cut-off 12.00 V: `set battery-range 1000 1200` refuses it.
+    saved["battery_full_centivolts"] = 1000.into();
+    saved["battery_cutoff_centivolts"] = 1200.into();
+    saved["max_speed"] = 700.into();
+    std::fs::write(&file, saved.to_string()).unwrap();
+    let sent_before = board.commands().len();
+    let out = board.run(&["settings", "--restore", &file]);
+    assert_error(&out, &["not above cut-off", "nothing was written"]);
+    let _ = std::fs::remove_file(&file);
+    assert_eq!(board.commands().len(), sent_before, "nothing sent");
+    let (board, _) = board.finish();
+    assert_eq!(board.registers().max_speed, 1000);
+}
+
+#[test]
 fn bad_arguments_fail_before_the_board_is_asked() {
     let board = TestBoard::start();
     let out = board.run(&["set", "max-speed", "-1"]);

@@ -418,6 +418,42 @@ pub struct Chassis {
     link: Link<DriverCore>,
 }
 
+/// A register's raw value from what `read` gives for it (see `Chassis.write`).
+fn raw_value(register: &str, value: &Bound<'_, PyAny>) -> PyResult<u32> {
+    use pyo3::exceptions::{PyOverflowError, PyTypeError};
+    use pyo3::types::PyBool;
+    if value.is_instance_of::<PyBool>() {
+        return Err(PyTypeError::new_err(format!(
+            "{register}: {value} is a bool, not a value: give an int"
+        )));
+    }
+    if let Ok(mode) = value.extract::<SystemMode>() {
+        return Ok(mode.bits);
+    }
+    if register == "battery-range" {
+        if let Ok((full, cutoff)) = value.extract::<(Option<f64>, Option<f64>)>() {
+            let centi = |v: Option<f64>, what: &str| -> PyResult<u32> {
+                let Some(volts) = v else { return Ok(0x7FFF) };
+                let c = (volts * 100.0).round();
+                if !(0.0..=655.35).contains(&volts) || !c.is_finite() {
+                    return Err(PyValueError::new_err(format!(
+                        "battery-range: {what} {volts} V is out of range (0..=655.35 V, or None for the built-in table)"
+                    )));
+                }
+                Ok(c as u32)
+            };
+            return Ok((centi(full, "full")? << 16) | centi(cutoff, "cut-off")?);
+        }
+    }
+    value.extract::<u32>().map_err(|e| {
+        if e.is_instance_of::<PyOverflowError>(value.py()) {
+            PyValueError::new_err(format!("{register} = {value} is out of range"))
+        } else {
+            e
+        }
+    })
+}
+
 /// What `read` returns for a register.
 fn typed_value(py: Python<'_>, register: p::Register, raw: u32) -> PyResult<Py<PyAny>> {
     Ok(match register {
@@ -552,9 +588,21 @@ impl Chassis {
     /// Writes a register and reads it back (`UnconfirmedError` if the board does not show the
     /// value). A write that starts a 30 s gyro calibration (gyro-calibration 0xFFFF,
     /// system-mode switching bit 3 on) needs `calibrate=True`.
+    ///
+    /// `value` is what `read` gives: an `int`; for system-mode a `SystemMode` too; for
+    /// battery-range `(full_volts, cutoff_volts)`, `None` for the built-in table (the full
+    /// voltage above the cut-off).
     #[pyo3(signature = (register, value, *, calibrate = false))]
-    fn write(&self, py: Python<'_>, register: &str, value: u32, calibrate: bool) -> PyResult<()> {
+    fn write(
+        &self,
+        py: Python<'_>,
+        register: &str,
+        value: &Bound<'_, PyAny>,
+        calibrate: bool,
+    ) -> PyResult<()> {
+        let value = raw_value(register, value)?;
         let write = frames::write_of(register, value)?;
+        p::driver::host::check_write(write).map_err(PyValueError::new_err)?;
         let r = write.register();
         let starts = match write {
             p::Write::GyroCalibration(0xFFFF) => true,
@@ -609,6 +657,8 @@ impl Chassis {
         let value = crate::json::from_py(settings.as_any())?;
         let wanted: p::Snapshot = serde_json::from_value(value)
             .map_err(|e| PyValueError::new_err(format!("not a settings dict: {e}")))?;
+        p::driver::host::check_settings(&wanted)
+            .map_err(|e| PyValueError::new_err(format!("{e}; nothing was written")))?;
         let board = self.link.with(py, |d| {
             d.restore_settings(&wanted)?;
             d.read_settings()
@@ -948,7 +998,17 @@ impl ChassisV1 {
     /// Writes one settings field: its frame is read back, written with the field changed (at
     /// least 100 ms after the previous settings frame), and read back again
     /// (`UnconfirmedError` if the board does not show it).
-    fn write(&self, py: Python<'_>, name: &str, value: u16) -> PyResult<()> {
+    fn write(&self, py: Python<'_>, name: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        if value.is_instance_of::<pyo3::types::PyBool>() {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "{name}: {value} is a bool, not a value: give an int"
+            )));
+        }
+        let value: u16 = value.extract::<i64>().and_then(|v| {
+            u16::try_from(v).map_err(|_| {
+                PyValueError::new_err(format!("{name} = {v} is out of range (0..=65535)"))
+            })
+        })?;
         let Some(r) = p::v1::field_readback(name) else {
             return Err(PyValueError::new_err(format!(
                 "{name:?} is not a v1.0.0 settings field: give one of {}",

@@ -10,7 +10,7 @@ import pathlib
 import pytest
 
 import chassis
-from conftest import FORCED_STOP, FORWARD, STOP, TURN_90, V1_FORWARD
+from conftest import FORCED_STOP, FORWARD, STOP, TURN_90, V1_FORWARD, frames_2020
 
 GOLDEN = pathlib.Path(__file__).resolve().parents[2] / "cli" / "tests" / "golden"
 
@@ -203,3 +203,37 @@ def test_bad_values_are_value_errors_with_nothing_sent(board: chassis.sim.Pty, v
             v1.wait_frame(-0.5)
         assert len(v1_board.received) == before
         assert v1.wait_frame(float("inf")) is not None
+
+
+def test_write_takes_what_read_gives_and_refuses_what_no_owner_means(board: chassis.sim.Pty, v1_board: chassis.sim.Pty) -> None:
+    with chassis.open(board.path, firmware="2020") as bot:
+        bot.write("battery-range", (12.6, 10.5))
+        assert bot.read("battery-range") == (12.6, 10.5)
+        bot.write("battery-range", (None, None))
+        assert bot.read("battery-range") == (None, None)
+        mode = bot.read("system-mode")
+        assert isinstance(mode, chassis.SystemMode)
+        bot.write("system-mode", mode)
+        assert bot.read("system-mode") == mode
+        before = len(board.received)
+        with pytest.raises(ValueError, match="not above cut-off"):
+            bot.write("battery-range", (10.0, 12.0))
+        with pytest.raises(TypeError, match="bool"):
+            bot.write("max-speed", True)
+        with pytest.raises(ValueError, match="out of range"):
+            bot.write("max-speed", 10**30)
+        saved = bot.settings()
+        inverted = dict(saved, battery_full_centivolts=1000, battery_cutoff_centivolts=1200)
+        with pytest.raises(ValueError, match="nothing was written"):
+            bot.restore(inverted)
+        # The refusals sent nothing; settings() only read (2C: settings frames, read codes
+        # 0x11 and up; the writes' codes are 0x01..0x0C).
+        assert all(f[2] == 0x80 and f[4] >= 0x11 for f in frames_2020(board.received[before:]))
+    with chassis.open(v1_board.path, firmware="v1.0.0") as v1:
+        before = len(v1_board.received)
+        with pytest.raises(TypeError, match="bool"):
+            v1.write("wheel-diameter", True)
+        with pytest.raises(ValueError, match="out of range"):
+            v1.write("wheel-diameter", 70_000)
+        assert v1_board.received[before:] == b""
+

@@ -210,6 +210,33 @@ pub fn open(path: &str) -> Result<HostDriver, SerialError> {
     Ok(Driver::new(port, MonotonicClock::new(), Config::HOST))
 }
 
+/// `Err` with the reason, in the `chassis` command's words, for a write the board would take
+/// but that no owner means: a battery range whose full voltage is not above its cut-off
+/// (0x7FFF for either, the built-in table, is always right). The `chassis` command and the
+/// Python package check every write and every restore with it before anything is sent.
+pub fn check_write(write: crate::Write) -> Result<(), String> {
+    const TABLE: u16 = 0x7FFF;
+    match write {
+        crate::Write::BatteryRange {
+            full_centivolts: full,
+            cutoff_centivolts: cut,
+        } if full != TABLE && cut != TABLE && full <= cut => Err(format!(
+            "battery-range: full {:.2} V is not above cut-off {:.2} V (FULL comes first)",
+            f64::from(full) / 100.0,
+            f64::from(cut) / 100.0
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// [`check_write`] for each register a restore of `settings` writes.
+pub fn check_settings(settings: &crate::registers::Snapshot) -> Result<(), String> {
+    check_write(crate::Write::BatteryRange {
+        full_centivolts: settings.battery_full_centivolts,
+        cutoff_centivolts: settings.battery_cutoff_centivolts,
+    })
+}
+
 /// A driver error in the words of the `chassis` command (and of the Python package), for a
 /// person: `silent` says nothing at all came from the board on `port` (then, and only then, the
 /// words ask about power and wiring).
