@@ -5,11 +5,12 @@
 //! writes to the board. Before anything moves, a warning and a question (`--yes` answers it).
 //! SIGINT, SIGTERM and SIGHUP stop the chassis (a turn cancelled) and end the check.
 
-use crate::device::core_words;
+use crate::device::{core_words, heard_2020};
 use crate::port::{self, Board, Port, SharedClock};
 use crate::signals;
 use chassis_bringup::link::Blocking;
 use chassis_bringup::{Check, Failure, Link, LinkError, Note, Plan, Report, Skip, Why, bring_up};
+use chassis_protocol::driver::host::Heard;
 use chassis_protocol::driver::{DriverCore, Error, Event};
 use chassis_protocol::registers::Snapshot;
 use chassis_protocol::{DriveType, Register, Stream, Turn, Velocity, Write};
@@ -154,17 +155,17 @@ impl Link for Checker {
 }
 
 /// Why a check failed, in words.
-fn why(failure: &Failure, heard: bool, port: &str) -> String {
+fn why(failure: &Failure, heard: Heard, port: &str) -> String {
     match failure.why {
         Why::Driver(Error::Transport(embedded_io::ErrorKind::Interrupted)) => {
             "interrupted".into()
         }
-        Why::Driver(Error::Core(e)) => core_words(e, !heard, port),
+        Why::Driver(Error::Core(e)) => core_words(e, heard, port),
         Why::Driver(Error::Transport(kind)) => format!(
             "the serial port failed ({kind:?}): was the adapter unplugged, or the board's power cut?"
         ),
         Why::Driver(e) => format!("the driver failed: {e:?}"),
-        Why::Rate(stream, per_10s) if !heard => format!(
+        Why::Rate(stream, per_10s) if heard == Heard::Nothing => format!(
             "no telemetry ({stream:?} {:.1} Hz): is the board powered, TX wired to RX and RX to TX, at 115200 bps?",
             f64::from(per_10s) / 10.0
         ),
@@ -335,7 +336,8 @@ pub fn check(
                     }
                 );
             }
-            let heard = link.core().last_heard_ms().is_some();
+            let now = link.now_ms();
+            let heard = heard_2020(link.core(), now);
             let code = u8::try_from(failure.check.exit_code()).unwrap_or(1);
             // The checks that would have run after it (not those a --no-motion run skips).
             let not_run: Vec<&str> = Check::ALL

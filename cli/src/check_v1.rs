@@ -10,13 +10,14 @@
 //! by an angle: its checks are eight, the turn a rotation at a rate.
 
 use crate::check::confirm;
-use crate::device::core_words;
+use crate::device::{core_words, heard_v1};
 use crate::port::{self, BoardV1, Port, SharedClock};
 use crate::signals;
 use chassis_bringup::link::Blocking;
 use chassis_bringup::v1::{LinkV1, ReportV1, WhyV1, bring_up_v1};
 use chassis_bringup::{Check, Failure, LinkError, Note, Plan, Skip};
 use chassis_protocol::driver::Error;
+use chassis_protocol::driver::host::Heard;
 use chassis_protocol::driver::v1::{DriverCore, Event};
 use chassis_protocol::v1::{BodyVelocity, Readback, Reply};
 use std::io::Write as _;
@@ -151,17 +152,17 @@ fn units(milli: i32) -> f64 {
 }
 
 /// Why a check failed, in words.
-fn why(why: WhyV1, heard: bool, port: &str) -> String {
+fn why(why: WhyV1, heard: Heard, port: &str) -> String {
     match why {
         WhyV1::Driver(Error::Transport(embedded_io::ErrorKind::Interrupted)) => {
             "interrupted".into()
         }
-        WhyV1::Driver(Error::Core(e)) => core_words(e, !heard, port),
+        WhyV1::Driver(Error::Core(e)) => core_words(e, heard, port),
         WhyV1::Driver(Error::Transport(kind)) => format!(
             "the serial port failed ({kind:?}): was the adapter unplugged, or the board's power cut?"
         ),
         WhyV1::Driver(e) => format!("the driver failed: {e:?}"),
-        WhyV1::Rate(per_10s) if !heard => format!(
+        WhyV1::Rate(per_10s) if heard == Heard::Nothing => format!(
             "no telemetry ({:.1} Hz): is the board powered, TX wired to RX and RX to TX, at 115200 bps?",
             f64::from(per_10s) / 10.0
         ),
@@ -323,7 +324,8 @@ pub fn check(path: &str, no_motion: bool, yes: bool) -> Result<(), (String, u8)>
             }
         );
     }
-    let heard = LinkV1::core(&link).last_heard_ms().is_some();
+    let now = link.now_ms();
+    let heard = heard_v1(LinkV1::core(&link), now);
     let code = u8::try_from(failure.check.exit_code()).unwrap_or(1);
     let not_run: Vec<&str> = CHECKS
         .iter()

@@ -101,13 +101,24 @@ pub fn detect_command(path: &str) -> Result<(), (String, u8)> {
 /// taken as the 2020 firmware (the command's own error then says what did not answer); bytes of
 /// neither generation are an error.
 pub fn generation(path: &str, given: Option<Firmware>) -> Result<Firmware, String> {
+    generation_or(path, given, Firmware::V2020)
+}
+
+/// [`generation`], a silent line taken as `silent`: the generation the command's own arguments
+/// belong to (`drive --vy`, `get geometry`: v1.0.0), so that its error says that nothing
+/// answered rather than that the arguments are the other firmware's.
+pub fn generation_or(
+    path: &str,
+    given: Option<Firmware>,
+    silent: Firmware,
+) -> Result<Firmware, String> {
     if let Some(firmware) = given {
         return Ok(firmware);
     }
     let found = listen(path)?;
     match found.firmware {
         Some(firmware) => Ok(firmware),
-        None if found.heard.bytes == 0 => Ok(Firmware::V2020),
+        None if found.heard.bytes == 0 => Ok(silent),
         None => Err(format!(
             "{}; --firmware 2020|v1.0.0 skips this check",
             undecided(path, &found).0

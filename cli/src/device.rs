@@ -10,6 +10,7 @@ use crate::names::{RegisterName, register_name};
 use crate::newfile::NewFile;
 use crate::port::{self, Board};
 use crate::signals;
+use chassis_protocol::driver::host::Heard;
 use chassis_protocol::driver::host::SerialError;
 use chassis_protocol::driver::{CoreError, Error, Outcome, Request, TurnState};
 use chassis_protocol::{Action, Register, Snapshot, SystemMode, Velocity, Write};
@@ -25,16 +26,34 @@ pub fn open(port: &str) -> Result<Board, String> {
 pub fn explain(driver: &Board, e: Error<SerialError>) -> String {
     let port = driver.uart().name();
     match e {
-        Error::Core(e) => core_words(e, driver.core().last_heard_ms().is_none(), port),
+        Error::Core(e) => core_words(e, heard_2020(driver.core(), driver.uart().now_ms()), port),
         Error::Transport(e) => format!("serial port {port}: {}", e.0),
         other => other.to_string(),
     }
 }
 
-/// The driver's logic error `e` in the CLI's words (`silent`: nothing at all came from the
-/// board on `port`). Shared by every command and `chassis check` (and the Python package).
-pub fn core_words(e: CoreError, silent: bool, port: &str) -> String {
-    chassis_protocol::driver::host::words(e, silent, port)
+/// The driver's logic error `e` in the CLI's words, told by what came from the board on
+/// `port`. Shared by every command and `chassis check` (and the Python package).
+pub fn core_words(e: CoreError, heard: Heard, port: &str) -> String {
+    chassis_protocol::driver::host::words_heard(e, heard, port)
+}
+
+/// What came from a 2020 board, judged at `now_ms`.
+pub fn heard_2020(core: &chassis_protocol::driver::DriverCore, now_ms: u64) -> Heard {
+    Heard::from_link(
+        core.last_heard_ms(),
+        core.link_alive(now_ms),
+        core.parser_stats().discarded,
+    )
+}
+
+/// What came from a v1.0.0 board, judged at `now_ms`.
+pub fn heard_v1(core: &chassis_protocol::driver::v1::DriverCore, now_ms: u64) -> Heard {
+    Heard::from_link(
+        core.last_heard_ms(),
+        core.link_alive(now_ms),
+        core.parser_stats().discarded,
+    )
 }
 
 /// Reads `register` until two replies agree; its raw value.
@@ -312,11 +331,19 @@ fn stop_after(driver: &mut Board, ended: Result<String, String>) -> Result<Strin
             ),
         });
     }
+    // A turn whose cancellation was not confirmed may still run on the board.
+    let pending = if driver.core().turn_state() == TurnState::Idle {
+        ""
+    } else {
+        " (the board may still have the turn pending: run `chassis stop` once it answers again)"
+    };
     match (ended, stopped) {
         (Ok(line), Ok(())) => Ok(line),
         (Err(e), Ok(())) => Err(format!("{e}; the chassis was stopped")),
-        (Ok(_), Err(e)) => Err(format!("the stop was sent but not confirmed: {e}")),
-        (Err(e), Err(s)) => Err(format!("{e}; the stop was sent but not confirmed: {s}")),
+        (Ok(_), Err(e)) => Err(format!("the stop was sent but not confirmed: {e}{pending}")),
+        (Err(e), Err(s)) => Err(format!(
+            "{e}; the stop was sent but not confirmed: {s}{pending}"
+        )),
     }
 }
 

@@ -405,6 +405,18 @@ fn register_2020(name: &str) -> Result<RegisterName, String> {
 }
 
 /// The line for a command that has no meaning on v1.0.0.
+/// The generation a register or field name belongs to (a name of neither: 2020, whose error
+/// lists the names).
+fn names_generation(name: &str) -> Firmware {
+    let v1 = chassis_protocol::v1::Readback::from_name(name).is_some()
+        || chassis_protocol::v1::FIELDS.iter().any(|(n, _)| *n == name);
+    if v1 && chassis_protocol::Register::from_name(name).is_none() {
+        Firmware::V1_0_0
+    } else {
+        Firmware::V2020
+    }
+}
+
 fn not_on_v1(command: &str, why: &str) -> String {
     format!("{command}: this board runs the v1.0.0 firmware, and {why}")
 }
@@ -477,7 +489,7 @@ fn run(cli: Cli) -> Result<(), String> {
         Cmd::Detect => unreachable_in_run("detect"),
         Cmd::Get { register } => {
             let path = port(p)?;
-            match connect::generation(path, cli.firmware)? {
+            match connect::generation_or(path, cli.firmware, names_generation(&register))? {
                 Firmware::V2020 => device::get(path, register_2020(&register)?),
                 Firmware::V1_0_0 => v1cmd::get(path, &register),
             }
@@ -489,7 +501,7 @@ fn run(cli: Cli) -> Result<(), String> {
             yes,
         } => {
             let path = port(p)?;
-            match connect::generation(path, cli.firmware)? {
+            match connect::generation_or(path, cli.firmware, names_generation(&register))? {
                 Firmware::V2020 => device::set(
                     path,
                     register_2020(&register)?,
@@ -549,7 +561,12 @@ fn run(cli: Cli) -> Result<(), String> {
             let raw = [&axes.x, &axes.y, &axes.z]
                 .iter()
                 .any(|v| v.as_str() != "0");
-            match connect::generation(path, cli.firmware)? {
+            let silent = if si {
+                Firmware::V1_0_0
+            } else {
+                Firmware::V2020
+            };
+            match connect::generation_or(path, cli.firmware, silent)? {
                 Firmware::V2020 if si => Err(
                     "drive: --vx/--vy/--wz are for the v1.0.0 firmware; this board runs the 2020 one: give --x --y --z (the board's raw units)".into(),
                 ),

@@ -147,6 +147,11 @@ impl Port {
         &self.path
     }
 
+    /// The driver's last clock reading, ms (when it last looked: an error is judged then).
+    pub fn now_ms(&self) -> u64 {
+        self.now.get()
+    }
+
     /// The recording, if any.
     pub fn recorder(&self) -> Option<&Recorder> {
         self.record.as_ref()

@@ -26,9 +26,9 @@ pub fn names() -> String {
 /// A driver error as one line, in the CLI's words.
 fn explain(driver: &BoardV1, e: Error<SerialError>) -> String {
     let port = driver.uart().name();
-    let silent = driver.core().last_heard_ms().is_none();
+    let heard = crate::device::heard_v1(driver.core(), driver.uart().now_ms());
     match e {
-        Error::Core(e) => crate::device::core_words(e, silent, port),
+        Error::Core(e) => crate::device::core_words(e, heard, port),
         Error::Transport(e) => format!("serial port {port}: {}", e.0),
         other => other.to_string(),
     }

@@ -235,3 +235,61 @@ fn firmware_given_skips_detection() {
     let (_, heard) = board.finish();
     assert_eq!(frames(&heard), vec![FORCED_STOP]);
 }
+
+#[test]
+fn a_silent_line_is_taken_as_the_generation_the_arguments_belong_to() {
+    for args in [
+        &["drive", "--vy", "0.1", "--for", "1"][..],
+        &["get", "geometry"],
+    ] {
+        let (_board_end, path_end) = TTYPort::pair().unwrap();
+        let path = path_end.name().unwrap();
+        let mut all = vec!["--port", path.as_str()];
+        all.extend_from_slice(args);
+        let out = harness::chassis(&all);
+        let e = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {e}");
+        assert!(e.contains("nothing came from the board"), "{args:?}: {e}");
+        assert!(!e.contains("runs the 2020"), "{args:?}: {e}");
+        assert_eq!(e.lines().count(), 1, "{args:?}: {e}");
+    }
+}
+
+#[test]
+fn the_wrong_firmware_given_is_said_as_frames_of_another_firmware() {
+    let old = TestBoard::start();
+    let out = old.run(&["--firmware", "v1.0.0", "get", "geometry"]);
+    let e = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("bytes came from the board") && e.contains("chassis detect"),
+        "{e}"
+    );
+    assert!(!e.contains("is it powered"), "{e}");
+    let v1 = v1_board();
+    let out = v1.run(&["--firmware", "2020", "get", "max-speed"]);
+    let e = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("bytes came from the board") && e.contains("chassis detect"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_board_gone_quiet_during_a_turn_is_said_so_with_what_to_do() {
+    let board = TestBoard::start();
+    let child = board.spawn(&["turn", "360"]);
+    board.wait_for(
+        "the turn",
+        |c| matches!(c, chassis_protocol::Command::Turn(t) if t.deci_degrees == 3600),
+    );
+    std::thread::sleep(Duration::from_millis(300));
+    board.go_silent(true);
+    let out = wait(child, 15);
+    let e = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(e.contains("went quiet"), "{e}");
+    assert!(!e.contains("telemetry arrives"), "{e}");
+    assert!(e.contains("chassis stop"), "{e}");
+}

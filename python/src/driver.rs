@@ -62,19 +62,27 @@ fn lock<K: Core>(state: &Mutex<State<K>>) -> MutexGuard<'_, State<K>> {
 
 /// What the Python side needs of each generation's core to word its errors.
 pub trait Heard {
-    /// Whether nothing at all came from the board.
-    fn silent(&self) -> bool;
+    /// What has come from the board, judged at `now_ms`.
+    fn heard(&self, now_ms: u64) -> p::driver::host::Heard;
 }
 
 impl Heard for DriverCore {
-    fn silent(&self) -> bool {
-        self.last_heard_ms().is_none()
+    fn heard(&self, now_ms: u64) -> p::driver::host::Heard {
+        p::driver::host::Heard::from_link(
+            self.last_heard_ms(),
+            self.link_alive(now_ms),
+            self.parser_stats().discarded,
+        )
     }
 }
 
 impl Heard for v1::DriverCore {
-    fn silent(&self) -> bool {
-        self.last_heard_ms().is_none()
+    fn heard(&self, now_ms: u64) -> p::driver::host::Heard {
+        p::driver::host::Heard::from_link(
+            self.last_heard_ms(),
+            self.link_alive(now_ms),
+            self.parser_stats().discarded,
+        )
     }
 }
 
@@ -126,7 +134,11 @@ where
             let Some(driver) = state.driver.as_mut() else {
                 return Err(closed(port));
             };
-            f(driver).map_err(|e| driver_error(e, driver.core().silent(), port))
+            f(driver).map_err(|e| {
+                use chassis_protocol::driver::Clock as _;
+                let mut clock = self.clock;
+                driver_error(e, driver.core().heard(clock.now_ms()), port)
+            })
         })
     }
 

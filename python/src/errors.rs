@@ -1,7 +1,7 @@
 //! The package's exceptions: one class per kind of driver error, each under `ChassisError`, with
 //! the `chassis` command's words.
 
-use chassis_protocol::driver::host::{SerialError, words};
+use chassis_protocol::driver::host::{Heard, SerialError, words_heard};
 use chassis_protocol::driver::{CoreError, Error};
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
@@ -50,16 +50,18 @@ create_exception!(
     "Bytes that are not a frame of the kind asked for."
 );
 
-/// A driver error as the exception of its kind, in the CLI's words. `silent`: nothing at all
-/// came from the board on `port`.
-pub fn driver_error(e: Error<SerialError>, silent: bool, port: &str) -> PyErr {
+/// A driver error as the exception of its kind, in the CLI's words, told by what came from the
+/// board on `port` (`heard`): a read unanswered by a board that never said anything is a
+/// `TimeoutError` whatever its kind.
+pub fn driver_error(e: Error<SerialError>, heard: Heard, port: &str) -> PyErr {
+    let silent = heard == Heard::Nothing;
     match e {
         Error::Transport(e) => TransportError::new_err(format!("serial port {port}: {}", e.0)),
         Error::WriteZero => {
             TransportError::new_err(format!("serial port {port}: it accepted no bytes"))
         }
         Error::Core(core) => {
-            let text = words(core, silent, port);
+            let text = words_heard(core, heard, port);
             match core {
                 CoreError::Timeout(_) | CoreError::NoReadback(_) | CoreError::ClockStalled => {
                     TimeoutError::new_err(text)

@@ -237,20 +237,76 @@ pub fn check_settings(settings: &crate::registers::Snapshot) -> Result<(), Strin
     })
 }
 
+/// What has come from the board, for [`words_heard`]: what a person is told to check
+/// depends on it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Heard {
+    /// Not a byte: power, wiring, baud rate.
+    Nothing,
+    /// Bytes, but no frame the driver's firmware generation reads: the other firmware, another
+    /// device, another baud rate.
+    NoFrame,
+    /// Frames came, but none within the failsafe time: the board went quiet.
+    Quiet,
+    /// Frames arrive.
+    Frames,
+}
+
+impl Heard {
+    /// From a driver core's `last_heard_ms()`, `link_alive(now)` and the bytes its parser
+    /// discarded.
+    #[must_use]
+    pub const fn from_link(last_heard_ms: Option<u64>, link_alive: bool, discarded: u32) -> Self {
+        match (last_heard_ms, link_alive) {
+            (None, _) if discarded > 0 => Heard::NoFrame,
+            (None, _) => Heard::Nothing,
+            (Some(_), false) => Heard::Quiet,
+            (Some(_), true) => Heard::Frames,
+        }
+    }
+}
+
+/// A driver error in the words of the `chassis` command (and of the Python package), for a
+/// person, told by what has come from the board on `port` ([`Heard`]).
+#[must_use]
+pub fn words_heard(e: super::CoreError, heard: Heard, port: &str) -> String {
+    use super::CoreError;
+    let read = match e {
+        CoreError::Timeout(r) | CoreError::Unconfirmed(r) => format!("the read of {}", r.name()),
+        CoreError::NoReadback(r) => format!("the readback of {}", readback_name(r)),
+        _ => return words(e, heard == Heard::Nothing, port),
+    };
+    match heard {
+        Heard::Nothing => words(e, true, port),
+        Heard::NoFrame => format!(
+            "bytes came from the board on {port}, but no frame of the firmware this command speaks: no answer to {read} (the other firmware? `chassis detect` tells; or a baud rate other than 115200)"
+        ),
+        Heard::Quiet => format!(
+            "the board on {port} went quiet: no answer to {read}, and no telemetry within the failsafe time (its power, the cable?)"
+        ),
+        Heard::Frames => words(e, false, port),
+    }
+}
+
+/// A readback's name as the `chassis` command spells it.
+const fn readback_name(r: crate::v1::Readback) -> &'static str {
+    use crate::v1::Readback;
+    match r {
+        Readback::System => "system",
+        Readback::Geometry => "geometry",
+        Readback::BodyVelocity => "body-velocity",
+        Readback::MotorSpeeds => "motor-speeds",
+        Readback::Pid => "pid",
+    }
+}
+
 /// A driver error in the words of the `chassis` command (and of the Python package), for a
 /// person: `silent` says nothing at all came from the board on `port` (then, and only then, the
 /// words ask about power and wiring).
 #[must_use]
 pub fn words(e: super::CoreError, silent: bool, port: &str) -> String {
     use super::CoreError;
-    use crate::v1::Readback;
-    let readback = |r: Readback| match r {
-        Readback::System => "system",
-        Readback::Geometry => "geometry",
-        Readback::BodyVelocity => "body-velocity",
-        Readback::MotorSpeeds => "motor-speeds",
-        Readback::Pid => "pid",
-    };
+    let readback = readback_name;
     const WIRING: &str = "is it powered, TX wired to RX and RX to TX, at 115200 bps?";
     match e {
         CoreError::Timeout(r) | CoreError::Unconfirmed(r) if silent => format!(
