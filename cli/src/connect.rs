@@ -104,6 +104,29 @@ pub fn generation(path: &str, given: Option<Firmware>) -> Result<Firmware, Strin
     generation_or(path, given, Firmware::V2020)
 }
 
+/// [`generation`] for `chassis check`: bytes of neither generation fail its link check (exit
+/// status 10, as the firmware's bring-up does), with nothing sent.
+pub fn generation_for_check(path: &str, given: Option<Firmware>) -> Result<Firmware, (String, u8)> {
+    if let Some(firmware) = given {
+        return Ok(firmware);
+    }
+    let found = listen(path).map_err(|e| (e, 1))?;
+    match found.firmware {
+        Some(firmware) => Ok(firmware),
+        None if found.heard.bytes == 0 => Ok(Firmware::V2020),
+        None => Err((
+            format!(
+                "FAIL: link: {}; nothing was sent (--firmware 2020|v1.0.0 skips this check)",
+                undecided(path, &found).0
+            ),
+            LINK_CHECK_FAILED,
+        )),
+    }
+}
+
+/// The exit status of `chassis check` when its link check fails.
+const LINK_CHECK_FAILED: u8 = 10;
+
 /// [`generation`], a silent line taken as `silent`: the generation the command's own arguments
 /// belong to (`drive --vy`, `get geometry`: v1.0.0), so that its error says that nothing
 /// answered rather than that the arguments are the other firmware's.

@@ -212,8 +212,17 @@ fn restored(file: &str, wanted: &Snapshot, board: &Snapshot) -> String {
 pub fn settings(port: &str, save: Option<&str>, restore: Option<&str>) -> Result<(), String> {
     if let Some(file) = restore {
         let text = std::fs::read_to_string(file).map_err(|e| format!("cannot read {file}: {e}"))?;
-        let snapshot: Snapshot =
-            serde_json::from_str(&text).map_err(|e| format!("{file}: not a settings file: {e}"))?;
+        let snapshot: Snapshot = serde_json::from_str(&text).map_err(|e| {
+            let v1 = serde_json::from_str::<serde_json::Value>(&text)
+                .is_ok_and(|v| v.get("firmware").and_then(|f| f.as_str()) == Some("v1.0.0"));
+            if v1 {
+                format!(
+                    "{file}: a v1.0.0 settings file, and this board runs the 2020 firmware: nothing was written"
+                )
+            } else {
+                format!("{file}: not a settings file: {e}")
+            }
+        })?;
         chassis_protocol::driver::host::check_settings(&snapshot)
             .map_err(|e| format!("{file}: {e}; nothing was written"))?;
         let mut driver = open(port)?;

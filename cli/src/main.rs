@@ -169,7 +169,7 @@ enum Cmd {
         #[arg(long, value_name = "RAD/S", allow_hyphen_values = true)]
         wz: Option<f64>,
         /// How long, in seconds.
-        #[arg(long = "for", value_name = "SECONDS")]
+        #[arg(long = "for", value_name = "SECONDS", allow_hyphen_values = true)]
         seconds: f64,
     },
     /// Turn by DEGREES (sent once: the board adds turns up) and wait until it is done (Ctrl-C
@@ -213,7 +213,7 @@ enum Cmd {
         #[arg(long, value_name = "FILE")]
         out: String,
         /// Stop after SECONDS (default: until Ctrl-C).
-        #[arg(long = "for", value_name = "SECONDS")]
+        #[arg(long = "for", value_name = "SECONDS", allow_hyphen_values = true)]
         seconds: Option<f64>,
     },
     /// Serve a simulated board (prints where).
@@ -268,8 +268,7 @@ fn main() -> ExitCode {
         } => port(cli.port.as_deref())
             .map_err(|e| (e, 1))
             .and_then(|path| {
-                if connect::generation(path, cli.firmware).map_err(|e| (e, 1))?
-                    == Firmware::V1_0_0
+                if connect::generation_for_check(path, cli.firmware)? == Firmware::V1_0_0
                 {
                     if drive_type.is_some() {
                         return Err((

@@ -195,8 +195,14 @@ pub fn stop(path: &str) -> Result<(), String> {
 pub fn milli(value: f64, name: &str, unit: &str) -> Result<i16, String> {
     let m = (value * 1000.0).round();
     if !m.is_finite() || !(f64::from(i16::MIN)..=f64::from(i16::MAX)).contains(&m) {
+        // A huge value in exponent form, not 300 digits.
+        let shown = if value.abs() < 1e6 {
+            format!("{value}")
+        } else {
+            format!("{value:e}")
+        };
         return Err(format!(
-            "--{name}: {value} {unit} is out of range (±32.767, the frame's 16 bits in thousandths)"
+            "--{name}: {shown} {unit} is out of range (±32.767, the frame's 16 bits in thousandths)"
         ));
     }
     Ok(m as i16)

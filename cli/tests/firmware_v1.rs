@@ -293,3 +293,54 @@ fn a_board_gone_quiet_during_a_turn_is_said_so_with_what_to_do() {
     assert!(!e.contains("telemetry arrives"), "{e}");
     assert!(e.contains("chassis stop"), "{e}");
 }
+
+#[test]
+fn get_names_the_fields_as_decode_does() {
+    // The keys of each reply in chassis decode's golden output (hand-written from the spec),
+    // less those that place the frame.
+    let golden = include_str!("golden/v1_downlink.jsonl");
+    let decode_keys = |request: &str| -> Vec<String> {
+        let line = golden
+            .lines()
+            .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
+            .find(|v| v["frame"] == "v1-reply" && v["request"] == request)
+            .unwrap_or_else(|| panic!("{request} in the golden file"));
+        let mut keys: Vec<String> = line
+            .as_object()
+            .unwrap()
+            .keys()
+            .filter(|k| !["offset", "frame", "request", "code"].contains(&k.as_str()))
+            .cloned()
+            .collect();
+        keys.sort();
+        keys
+    };
+    let board = v1_board();
+    for request in ["system", "geometry", "body-velocity", "motor-speeds", "pid"] {
+        let out = board.run(&["get", request]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let mut keys: Vec<String> = json.as_object().unwrap().keys().cloned().collect();
+        keys.sort();
+        assert_eq!(keys, decode_keys(request), "get {request}");
+    }
+}
+
+#[test]
+fn a_v1_settings_file_on_a_2020_board_is_named_as_such_with_nothing_written() {
+    let v1 = v1_board();
+    let file = std::env::temp_dir().join(format!("chassis-v1-on-2020-{}.json", std::process::id()));
+    let file = file.to_str().unwrap().to_string();
+    let out = v1.run(&["settings", "--save", &file]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    drop(v1);
+    let old = TestBoard::start();
+    let out = old.run(&["settings", "--restore", &file]);
+    let e = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(e.contains("a v1.0.0 settings file"), "{e}");
+    assert_eq!(e.lines().count(), 1, "{e}");
+    let (_, heard) = old.finish();
+    assert!(heard.is_empty(), "sent {heard:02X?}");
+    let _ = std::fs::remove_file(&file);
+}

@@ -129,7 +129,28 @@ fn bytes_of_neither_generation_get_no_verdict() {
     });
     assert_eq!(found.firmware, None, "{found:?}");
     assert!(found.heard.bytes > 1_000);
-    assert_eq!(wrote.len(), PROBE_2020.len() + PROBE_V1.len());
+    // The line was not quiet: no probe to a device that is not the board.
+    assert!(!found.probed);
+    assert!(wrote.is_empty(), "sent {wrote:02X?}");
+}
+
+#[test]
+fn a_glitch_or_two_on_a_quiet_line_still_gets_the_probes() {
+    let mut glitches = 2;
+    let (found, wrote) = run_on(move |buf| {
+        if glitches > 0 && !buf.is_empty() {
+            glitches -= 1;
+            buf[0] = 0x00;
+            1
+        } else {
+            0
+        }
+    });
+    assert!(found.probed);
+    assert_eq!(found.heard.bytes, 2);
+    let mut expected = PROBE_2020.to_vec();
+    expected.extend(PROBE_V1);
+    assert_eq!(wrote, expected);
 }
 
 #[test]

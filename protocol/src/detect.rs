@@ -213,9 +213,15 @@ pub const PROBE_GAP_MS: u64 = 20;
 #[cfg_attr(docsrs, doc(cfg(feature = "driver")))]
 pub const STALL_POLLS: u32 = 1_000_000;
 
+/// A line that carried fewer bytes than this while [`detect`] listened is quiet (a glitch or
+/// two at power-up); a board of either generation sends hundreds in that time.
+#[cfg(feature = "driver")]
+const QUIET_BELOW_BYTES: u32 = 16;
+
 /// Finds the firmware generation of the board on `uart`: listens [`LISTEN_MS`]; if that does
-/// not decide, sends [`PROBE_2020`], then [`PROBE_V1`] [`PROBE_GAP_MS`] later, and listens
-/// [`LISTEN_MS`] again. Sends nothing else, ever. Returns within about a second (or once the
+/// not decide and the line was quiet (a few bytes at most), sends [`PROBE_2020`], then
+/// [`PROBE_V1`] [`PROBE_GAP_MS`] later, and listens [`LISTEN_MS`] again. Bytes of neither
+/// generation (another device, another baud rate) get no probe. Sends nothing else, ever. Returns within about a second (or once the
 /// clock is found standing still); a transport error ends it with that error.
 ///
 /// Run it on a driverless UART, before a driver takes it; `config.idle_ms` says how long a
@@ -238,7 +244,9 @@ where
         idle_ms: u64::from(config.idle_ms),
     };
     let mut probed = false;
-    if !line.listen(uart, clock, &mut detector, start, LISTEN_MS)? {
+    if !line.listen(uart, clock, &mut detector, start, LISTEN_MS)?
+        && detector.heard().bytes < QUIET_BELOW_BYTES
+    {
         probed = true;
         write_all(uart, &PROBE_2020)?;
         detector.probed();

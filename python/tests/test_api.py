@@ -237,3 +237,16 @@ def test_write_takes_what_read_gives_and_refuses_what_no_owner_means(board: chas
             v1.write("wheel-diameter", 70_000)
         assert v1_board.received[before:] == b""
 
+
+
+def test_v1_reads_name_the_fields_as_chassis_decode_does(v1_board: chassis.sim.Pty) -> None:
+    with chassis.open(v1_board.path, firmware="v1.0.0") as v1:
+        assert sorted(v1.read("system")) == [
+            "encoder_direction_bits",
+            "encoder_ppr",
+            "motor_direction_bits",
+            "pwm_max",
+            "pwm_min",
+        ]
+        assert sorted(v1.read("motor-speeds")) == ["ctl", "speeds_raw", "type"]
+        assert sorted(v1.read("body-velocity")) == ["ctl", "type", "vx_mm_s", "vy_mm_s", "wz_mrad_s"]

@@ -198,7 +198,8 @@ pub struct BodyVelocity {
     /// kept.
     pub ctl: u8,
     /// The vehicle type ("divisor mode"): 4 in the vendor's mecanum example; other values
-    /// unknown. Kept raw.
+    /// unknown. Kept raw. `"type"` in JSON, as the vendor calls it.
+    #[cfg_attr(feature = "serde", serde(rename = "type", alias = "kind"))]
     pub kind: u8,
     /// Sideways, mm/s.
     pub vx_mm_s: i16,
@@ -270,9 +271,11 @@ impl BodyVelocity {
 pub struct MotorVelocity {
     /// The control byte (2 in a command; in a `0x36` reply, the board's control mode).
     pub ctl: u8,
-    /// The vehicle type, as [`BodyVelocity::kind`].
+    /// The vehicle type, as [`BodyVelocity::kind`] (`"type"` in JSON).
+    #[cfg_attr(feature = "serde", serde(rename = "type", alias = "kind"))]
     pub kind: u8,
-    /// M1..M4, raw.
+    /// M1..M4, raw (`"speeds_raw"` in JSON: the unit is the board's own).
+    #[cfg_attr(feature = "serde", serde(rename = "speeds_raw", alias = "speeds"))]
     pub speeds: [i16; 4],
 }
 
@@ -317,9 +320,17 @@ impl MotorVelocity {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SystemSettings {
-    /// Motor direction bits (meaning unknown).
+    /// Motor direction bits (meaning unknown; `"motor_direction_bits"` in JSON).
+    #[cfg_attr(
+        feature = "serde",
+        serde(rename = "motor_direction_bits", alias = "motor_directions")
+    )]
     pub motor_directions: u8,
-    /// Encoder direction bits (meaning unknown).
+    /// Encoder direction bits (meaning unknown; `"encoder_direction_bits"` in JSON).
+    #[cfg_attr(
+        feature = "serde",
+        serde(rename = "encoder_direction_bits", alias = "encoder_directions")
+    )]
     pub encoder_directions: u8,
     /// PWM maximum.
     pub pwm_max: u16,
