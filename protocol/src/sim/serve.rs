@@ -12,7 +12,8 @@ use std::time::{Duration, Instant};
 /// back (to inspect what it was told). `io`'s reads must time out (1 ms or so): each turn of
 /// the loop takes in what the master sent, moves the board's clock to the wall clock, and
 /// writes what the board has sent since. A read that times out or would block is no error; an
-/// end of stream ends the run. Bytes the other end does not take (a write that times out or
+/// end of stream ends the run. Once stopped, what is already waiting is read before the board
+/// is given back. Bytes the other end does not take (a write that times out or
 /// would block) are dropped, as on a line nobody listens to: the board serves until stopped.
 pub fn serve<B: Simulated, T: Read + Write>(
     mut board: B,
@@ -49,6 +50,17 @@ pub fn serve<B: Simulated, T: Read + Write>(
         match io.flush() {
             Err(e) if !nobody_reads(&e) => return Err(e),
             _ => {}
+        }
+    }
+    // Stopped: what the master sent before that is still waiting is taken in, so the board
+    // given back has heard every byte sent to it (a program that wrote and exited just now).
+    loop {
+        match io.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => board.receive(buf.get(..n).unwrap_or(&[])),
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+            // Nothing more waiting, or the stream gone: either way, done.
+            Err(_) => break,
         }
     }
     Ok(board)
