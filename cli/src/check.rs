@@ -262,6 +262,99 @@ fn verdict(
     lines.join("\n")
 }
 
+/// The checks of `order` that would have run after `failed` (not those a `--no-motion` run
+/// skips), by `name`: what a failed check's line lists as not run (both generations).
+pub fn not_run<T>(
+    order: impl IntoIterator<Item = Check>,
+    failed: Check,
+    done: &[(Check, T)],
+    no_motion: bool,
+    name: fn(Check) -> &'static str,
+) -> Vec<&'static str> {
+    order
+        .into_iter()
+        .filter(|c| !done.iter().any(|(d, _)| d == c) && *c != failed)
+        .filter(|c| !no_motion || !c.moves())
+        .map(name)
+        .collect()
+}
+
+/// What the bring-up's stop after a failure did, in words (`forced`: v1.0.0's forced stop;
+/// `why`: a driver error in words), for a failed check's line (both generations).
+pub fn stopped_words(
+    last_stop: Option<Result<(), LinkError>>,
+    no_motion: bool,
+    forced: bool,
+    why: impl FnOnce(LinkError) -> String,
+) -> String {
+    let (stop, how) = if forced {
+        ("forced stop", " (forced stop)")
+    } else {
+        ("stop", "")
+    };
+    match (last_stop, no_motion) {
+        (_, true) => String::new(),
+        (Some(Ok(())), false) => format!("; the chassis was stopped{how}"),
+        (Some(Err(e)), false) => format!(
+            "; the {stop} could not be sent ({}): the chassis may still be moving, cut its power",
+            why(e)
+        ),
+        (None, false) => "; nothing had moved".into(),
+    }
+}
+
+/// A failed check, on either generation.
+pub struct Ending {
+    /// The failed check's name.
+    pub check: &'static str,
+    /// A check was under way (its progress line waits for its end).
+    pub under_way: bool,
+    /// The checks that would have run after it.
+    pub not_run: Vec<&'static str>,
+    /// What the stop after the failure did ([`stopped_words`]).
+    pub stopped: String,
+    /// Why it failed, in words.
+    pub why: String,
+    /// The failed check's exit status.
+    pub code: u8,
+}
+
+/// Ends the progress line of the check under way and gives the failure's line and exit status:
+/// a signal's (128 + its number) if one ended the check, else the check's.
+pub fn ending(end: Ending) -> (String, u8) {
+    let interrupted = signals::caught();
+    if end.under_way {
+        say!(
+            "{}",
+            if interrupted.is_some() {
+                "interrupted"
+            } else {
+                "FAILED"
+            }
+        );
+    }
+    let tail = if end.not_run.is_empty() {
+        String::new()
+    } else {
+        format!("; not run: {}", end.not_run.join(", "))
+    };
+    let stopped = end.stopped;
+    match interrupted {
+        Some(signal) => (
+            format!(
+                "interrupted by {} during the {} check{stopped}{tail}",
+                signals::name(signal),
+                end.check
+            ),
+            signals::exit_status(signal),
+        ),
+        None => (
+            format!("FAIL: {}: {}{stopped}{tail}", end.check, end.why),
+            end.code,
+        ),
+    }
+}
+
 /// Asks before the chassis moves (`motion`: what it will do): `Ok(true)` to go on.
 pub fn confirm(path: &str, motion: &str) -> Result<bool, String> {
     let stdin = std::io::stdin();
@@ -325,67 +418,32 @@ pub fn check(
             Ok(())
         }
         Err(failure) => {
-            let interrupted = signals::caught();
-            if link.current.is_some() {
-                say!(
-                    "{}",
-                    if interrupted.is_some() {
-                        "interrupted"
-                    } else {
-                        "FAILED"
-                    }
-                );
-            }
             let now = link.now_ms();
             let heard = heard_2020(link.core(), now);
-            let code = u8::try_from(failure.check.exit_code()).unwrap_or(1);
-            // The checks that would have run after it (not those a --no-motion run skips).
-            let not_run: Vec<&str> = Check::ALL
-                .iter()
-                .filter(|c| !link.done.iter().any(|(d, _)| d == *c) && **c != failure.check)
-                .filter(|c| !no_motion || !c.moves())
-                .map(|c| c.name())
-                .collect();
-            let tail = if not_run.is_empty() {
-                String::new()
-            } else {
-                format!("; not run: {}", not_run.join(", "))
-            };
-            // What the bring-up's stop after the failure did.
-            let stopped = match (&link.last_stop, no_motion) {
-                (_, true) => String::new(),
-                (Some(Ok(())), false) => "; the chassis was stopped".into(),
-                (Some(Err(e)), false) => format!(
-                    "; the stop could not be sent ({}): the chassis may still be moving, cut its power",
-                    why(
-                        &Failure {
-                            check: failure.check,
-                            why: Why::Driver(*e)
-                        },
-                        heard,
-                        path
-                    )
+            let stopped = stopped_words(link.last_stop, no_motion, false, |e| {
+                why(
+                    &Failure {
+                        check: failure.check,
+                        why: Why::Driver(e),
+                    },
+                    heard,
+                    path,
+                )
+            });
+            Err(ending(Ending {
+                check: failure.check.name(),
+                under_way: link.current.is_some(),
+                not_run: not_run(
+                    Check::ALL,
+                    failure.check,
+                    &link.done,
+                    no_motion,
+                    Check::name,
                 ),
-                (None, false) => "; nothing had moved".into(),
-            };
-            match interrupted {
-                Some(signal) => Err((
-                    format!(
-                        "interrupted by {} during the {} check{stopped}{tail}",
-                        signals::name(signal),
-                        failure.check.name()
-                    ),
-                    signals::exit_status(signal),
-                )),
-                None => Err((
-                    format!(
-                        "FAIL: {}: {}{stopped}{tail}",
-                        failure.check.name(),
-                        why(&failure, heard, path)
-                    ),
-                    code,
-                )),
-            }
+                stopped,
+                why: why(&failure, heard, path),
+                code: u8::try_from(failure.check.exit_code()).unwrap_or(1),
+            }))
         }
     }
 }

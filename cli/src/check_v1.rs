@@ -9,7 +9,7 @@
 //! frames would overwrite what the owner tuned). v1.0.0 has no drive-type register and no turn
 //! by an angle: its checks are eight, the turn a rotation at a rate.
 
-use crate::check::confirm;
+use crate::check::{Ending, confirm, ending, not_run, stopped_words};
 use crate::device::{core_words, heard_v1};
 use crate::port::{self, BoardV1, Port, SharedClock};
 use crate::signals;
@@ -26,17 +26,11 @@ use std::time::Instant;
 /// What the check does to a v1.0.0 chassis, said before it starts.
 const MOTION: &str = "the chassis will move: forward and sideways at 0.3 m/s for 0.4 s each, a rotation at 1 rad/s for 1.2 s (about 70°), then 1.5 s forward at 0.15 m/s. Give it about a metre of clear floor, or lift it so its wheels turn freely";
 
-/// The checks of a v1.0.0 board, in order (no drive type: no register holds one).
-const CHECKS: [Check; 8] = [
-    Check::Link,
-    Check::Settings,
-    Check::Forward,
-    Check::Strafe,
-    Check::Turn,
-    Check::Stop,
-    Check::Battery,
-    Check::ControlLoop,
-];
+/// The checks of a v1.0.0 board, in order: the 2020 ones but the drive type (no register holds
+/// one).
+fn checks() -> impl Iterator<Item = Check> {
+    Check::ALL.into_iter().filter(|c| *c != Check::DriveType)
+}
 
 /// A check's name on v1.0.0 (its turn is a rotation at a rate).
 const fn name(check: Check) -> &'static str {
@@ -102,7 +96,7 @@ impl LinkV1 for CheckerV1 {
         self.inner.readback(readback)
     }
     fn note(&mut self, note: Note) {
-        let index = |c: Check| CHECKS.iter().position(|x| *x == c).unwrap_or(0) + 1;
+        let index = |c: Check| checks().position(|x| x == c).unwrap_or(0) + 1;
         let mut out = std::io::stdout().lock();
         match note {
             Note::Start(check) => {
@@ -313,57 +307,18 @@ pub fn check(path: &str, no_motion: bool, yes: bool) -> Result<(), (String, u8)>
         }
         Err(failure) => failure,
     };
-    let interrupted = signals::caught();
-    if link.current.is_some() {
-        say!(
-            "{}",
-            if interrupted.is_some() {
-                "interrupted"
-            } else {
-                "FAILED"
-            }
-        );
-    }
     let now = link.now_ms();
     let heard = heard_v1(LinkV1::core(&link), now);
-    let code = u8::try_from(failure.check.exit_code()).unwrap_or(1);
-    let not_run: Vec<&str> = CHECKS
-        .iter()
-        .filter(|c| !link.done.iter().any(|(d, _)| d == *c) && **c != failure.check)
-        .filter(|c| !no_motion || !c.moves())
-        .map(|c| name(*c))
-        .collect();
-    let tail = if not_run.is_empty() {
-        String::new()
-    } else {
-        format!("; not run: {}", not_run.join(", "))
-    };
-    let stopped = match (&link.last_stop, no_motion) {
-        (_, true) => String::new(),
-        (Some(Ok(())), false) => "; the chassis was stopped (forced stop)".into(),
-        (Some(Err(e)), false) => format!(
-            "; the forced stop could not be sent ({}): the chassis may still be moving, cut its power",
-            why(WhyV1::Driver(*e), heard, path)
-        ),
-        (None, false) => "; nothing had moved".into(),
-    };
+    let stopped = stopped_words(link.last_stop, no_motion, true, |e| {
+        why(WhyV1::Driver(e), heard, path)
+    });
     let Failure { check, why: reason } = failure;
-    Err(match interrupted {
-        Some(signal) => (
-            format!(
-                "interrupted by {} during the {} check{stopped}{tail}",
-                signals::name(signal),
-                name(check)
-            ),
-            signals::exit_status(signal),
-        ),
-        None => (
-            format!(
-                "FAIL: {}: {}{stopped}{tail}",
-                name(check),
-                why(reason, heard, path)
-            ),
-            code,
-        ),
-    })
+    Err(ending(Ending {
+        check: name(check),
+        under_way: link.current.is_some(),
+        not_run: not_run(checks(), check, &link.done, no_motion, name),
+        stopped,
+        why: why(reason, heard, path),
+        code: u8::try_from(check.exit_code()).unwrap_or(1),
+    }))
 }

@@ -204,37 +204,14 @@ fn the_v1_check_refuses_a_drive_type_and_asks_before_moving_with_nothing_sent() 
 
 #[test]
 fn bytes_of_neither_firmware_fail_the_link_check_with_nothing_sent() {
-    use serialport::SerialPort as _;
-    let (mut board_end, path_end) = serialport::TTYPort::pair().unwrap();
-    board_end.set_timeout(Duration::from_millis(20)).unwrap();
-    let mut talker_end = board_end.try_clone_native().unwrap();
-    let path = path_end.name().unwrap();
-    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    let flag = stop.clone();
-    // Another device: a steady stream of ASCII text (no FF, no 7B).
-    let talker = std::thread::spawn(move || {
-        while !flag.load(std::sync::atomic::Ordering::SeqCst) {
-            let _ = std::io::Write::write(&mut talker_end, b"temperature=21.5C\r\n");
-            std::thread::sleep(Duration::from_millis(5));
-        }
-    });
-    let out = harness::chassis(&["--port", &path, "check", "--yes"]);
-    stop.store(true, std::sync::atomic::Ordering::SeqCst);
-    talker.join().unwrap();
+    let device = harness::OtherDevice::start();
+    let out = harness::chassis(&["--port", &device.path, "check", "--yes"]);
+    let heard = device.finish();
     let (_, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(10), "{stderr}");
     assert!(
         stderr.contains("FAIL: link") && stderr.contains("no frame of either firmware"),
         "{stderr}"
     );
-    let mut heard = Vec::new();
-    let mut buf = [0u8; 64];
-    while let Ok(n) = std::io::Read::read(&mut board_end, &mut buf) {
-        if n == 0 {
-            break;
-        }
-        heard.extend_from_slice(&buf[..n]);
-    }
-    drop(path_end);
     assert!(heard.is_empty(), "sent {heard:02X?}");
 }

@@ -83,25 +83,14 @@ fn detect_on_a_silent_line_sends_only_the_probes_and_says_so_within_seconds() {
 
 #[test]
 fn detect_on_bytes_of_neither_generation_says_so() {
-    let (mut board_end, path_end) = TTYPort::pair().unwrap();
-    board_end.set_timeout(Duration::from_millis(1)).unwrap();
-    let path = path_end.name().unwrap();
-    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    let flag = stop.clone();
-    // Another device: a steady stream of ASCII text (no FF, no 7B).
-    let talker = std::thread::spawn(move || {
-        while !flag.load(std::sync::atomic::Ordering::SeqCst) {
-            let _ = std::io::Write::write(&mut board_end, b"temperature=21.5C\r\n");
-            std::thread::sleep(Duration::from_millis(5));
-        }
-    });
-    let out = harness::chassis(&["--port", &path, "detect"]);
-    stop.store(true, std::sync::atomic::Ordering::SeqCst);
-    talker.join().unwrap();
-    drop(path_end);
+    let device = harness::OtherDevice::start();
+    let out = harness::chassis(&["--port", &device.path, "detect"]);
+    let sent = device.finish();
     assert_eq!(out.status.code(), Some(4), "{}", text(&out.stderr));
     let line = text(&out.stderr);
     assert!(line.contains("no frame of either firmware"), "{line}");
+    // The line was not quiet: no probe to a device that is not the board.
+    assert!(sent.is_empty(), "sent {sent:02X?}");
     // A command then refuses to guess.
 }
 

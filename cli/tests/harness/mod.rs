@@ -492,3 +492,64 @@ pub fn sim_pty(extra: &[&str]) -> (Child, String) {
     .unwrap();
     (child, path.trim().to_string())
 }
+
+/// Another device on a pseudo-terminal, not the board: a steady stream of ASCII text (no `FF`,
+/// no `7B`), and every byte it is sent.
+pub struct OtherDevice {
+    /// The path the CLI opens.
+    pub path: String,
+    stop: Arc<AtomicBool>,
+    talker: Option<JoinHandle<Vec<u8>>>,
+    _keep: TTYPort,
+}
+
+impl OtherDevice {
+    /// Starts talking.
+    pub fn start() -> OtherDevice {
+        let (mut device_end, path_end) = TTYPort::pair().expect("a pseudo-terminal");
+        device_end.set_timeout(Duration::from_millis(1)).unwrap();
+        let path = path_end.name().expect("its path");
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&stop);
+        let talker = std::thread::spawn(move || {
+            let mut heard = Vec::new();
+            let mut buf = [0u8; 64];
+            let mut take_in = |device: &mut TTYPort, heard: &mut Vec<u8>| {
+                while let Ok(n @ 1..) = device.read(&mut buf) {
+                    heard.extend_from_slice(&buf[..n]);
+                }
+            };
+            while !flag.load(Ordering::SeqCst) {
+                let _ = device_end.write(b"temperature=21.5C\r\n");
+                take_in(&mut device_end, &mut heard);
+                std::thread::sleep(Duration::from_millis(5));
+            }
+            take_in(&mut device_end, &mut heard);
+            heard
+        });
+        OtherDevice {
+            path,
+            stop,
+            talker: Some(talker),
+            _keep: path_end,
+        }
+    }
+
+    /// Stops talking: every byte it was sent.
+    pub fn finish(mut self) -> Vec<u8> {
+        self.stop.store(true, Ordering::SeqCst);
+        self.talker
+            .take()
+            .map(|t| t.join().unwrap())
+            .unwrap_or_default()
+    }
+}
+
+impl Drop for OtherDevice {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::SeqCst);
+        if let Some(t) = self.talker.take() {
+            let _ = t.join();
+        }
+    }
+}
