@@ -5,7 +5,7 @@
 //! writes to the board. Before anything moves, a warning and a question (`--yes` answers it).
 //! SIGINT, SIGTERM and SIGHUP stop the chassis (a turn cancelled) and end the check.
 
-use crate::device::{core_words, heard_2020};
+use crate::device::core_words;
 use crate::port::{self, Board, Port, SharedClock};
 use crate::signals;
 use chassis_bringup::link::Blocking;
@@ -419,7 +419,7 @@ pub fn check(
         }
         Err(failure) => {
             let now = link.now_ms();
-            let heard = heard_2020(link.core(), now);
+            let heard = link.core().heard(now);
             let stopped = stopped_words(link.last_stop, no_motion, false, |e| {
                 why(
                     &Failure {

@@ -10,7 +10,7 @@
 //! by an angle: its checks are eight, the turn a rotation at a rate.
 
 use crate::check::{Ending, confirm, ending, not_run, stopped_words};
-use crate::device::{core_words, heard_v1};
+use crate::device::core_words;
 use crate::port::{self, BoardV1, Port, SharedClock};
 use crate::signals;
 use chassis_bringup::link::Blocking;
@@ -308,7 +308,7 @@ pub fn check(path: &str, no_motion: bool, yes: bool) -> Result<(), (String, u8)>
         Err(failure) => failure,
     };
     let now = link.now_ms();
-    let heard = heard_v1(LinkV1::core(&link), now);
+    let heard = LinkV1::core(&link).heard(now);
     let stopped = stopped_words(link.last_stop, no_motion, true, |e| {
         why(WhyV1::Driver(e), heard, path)
     });

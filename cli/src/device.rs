@@ -26,7 +26,7 @@ pub fn open(port: &str) -> Result<Board, String> {
 pub fn explain(driver: &Board, e: Error<SerialError>) -> String {
     let port = driver.uart().name();
     match e {
-        Error::Core(e) => core_words(e, heard_2020(driver.core(), driver.uart().now_ms()), port),
+        Error::Core(e) => core_words(e, driver.core().heard(driver.uart().now_ms()), port),
         Error::Transport(e) => format!("serial port {port}: {}", e.0),
         other => other.to_string(),
     }
@@ -36,24 +36,6 @@ pub fn explain(driver: &Board, e: Error<SerialError>) -> String {
 /// `port`. Shared by every command and `chassis check` (and the Python package).
 pub fn core_words(e: CoreError, heard: Heard, port: &str) -> String {
     chassis_protocol::driver::host::words_heard(e, heard, port)
-}
-
-/// What came from a 2020 board, judged at `now_ms`.
-pub fn heard_2020(core: &chassis_protocol::driver::DriverCore, now_ms: u64) -> Heard {
-    Heard::from_link(
-        core.last_heard_ms(),
-        core.link_alive(now_ms),
-        core.parser_stats().discarded,
-    )
-}
-
-/// What came from a v1.0.0 board, judged at `now_ms`.
-pub fn heard_v1(core: &chassis_protocol::driver::v1::DriverCore, now_ms: u64) -> Heard {
-    Heard::from_link(
-        core.last_heard_ms(),
-        core.link_alive(now_ms),
-        core.parser_stats().discarded,
-    )
 }
 
 /// Reads `register` until two replies agree; its raw value.

@@ -26,7 +26,7 @@ pub fn names() -> String {
 /// A driver error as one line, in the CLI's words.
 fn explain(driver: &BoardV1, e: Error<SerialError>) -> String {
     let port = driver.uart().name();
-    let heard = crate::device::heard_v1(driver.core(), driver.uart().now_ms());
+    let heard = driver.core().heard(driver.uart().now_ms());
     match e {
         Error::Core(e) => crate::device::core_words(e, heard, port),
         Error::Transport(e) => format!("serial port {port}: {}", e.0),

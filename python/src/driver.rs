@@ -68,21 +68,13 @@ pub trait Heard {
 
 impl Heard for DriverCore {
     fn heard(&self, now_ms: u64) -> p::driver::host::Heard {
-        p::driver::host::Heard::from_link(
-            self.last_heard_ms(),
-            self.link_alive(now_ms),
-            self.parser_stats().discarded,
-        )
+        DriverCore::heard(self, now_ms)
     }
 }
 
 impl Heard for v1::DriverCore {
     fn heard(&self, now_ms: u64) -> p::driver::host::Heard {
-        p::driver::host::Heard::from_link(
-            self.last_heard_ms(),
-            self.link_alive(now_ms),
-            self.parser_stats().discarded,
-        )
+        v1::DriverCore::heard(self, now_ms)
     }
 }
 

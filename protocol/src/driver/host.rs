@@ -266,6 +266,30 @@ impl Heard {
     }
 }
 
+impl super::DriverCore {
+    /// What has come from the board, judged at `now_ms` (for [`words_heard`]).
+    #[must_use]
+    pub fn heard(&self, now_ms: u64) -> Heard {
+        Heard::from_link(
+            self.last_heard_ms(),
+            self.link_alive(now_ms),
+            self.parser_stats().discarded,
+        )
+    }
+}
+
+impl super::v1::DriverCore {
+    /// What has come from the board, judged at `now_ms` (for [`words_heard`]).
+    #[must_use]
+    pub fn heard(&self, now_ms: u64) -> Heard {
+        Heard::from_link(
+            self.last_heard_ms(),
+            self.link_alive(now_ms),
+            self.parser_stats().discarded,
+        )
+    }
+}
+
 /// A driver error in the words of the `chassis` command (and of the Python package), for a
 /// person, told by what has come from the board on `port` ([`Heard`]).
 #[must_use]
