@@ -6,8 +6,8 @@
 //! SIGINT, SIGTERM and SIGHUP stop the chassis (a turn cancelled) and end the check.
 
 use crate::device::core_words;
+use crate::ending;
 use crate::port::{self, Board, Port, SharedClock};
-use crate::signals;
 use chassis_bringup::link::Blocking;
 use chassis_bringup::{Check, Failure, Link, LinkError, Note, Plan, Report, Skip, Why, bring_up};
 use chassis_protocol::driver::host::Heard;
@@ -20,8 +20,8 @@ use std::time::Instant;
 /// What the check does to a chassis, said before it starts.
 const MOTION: &str = "the chassis will move: forward and sideways for 0.4 s each at speed 300, one 90° turn, then 1.5 s forward at 150. Give it about a metre of clear floor, or lift it so its wheels turn freely";
 
-/// The check's [`Link`]: the host driver, with a progress line per check and the signals
-/// turned into an error at the next call (the bring-up then stops the chassis itself).
+/// The check's [`Link`]: the host driver, with a progress line per check and an ending (a
+/// signal, the terminal or input gone: [`crate::ending`]) turned into an error at the next call (the bring-up then stops the chassis itself).
 struct Checker {
     inner: Blocking<Port, SharedClock>,
     start: Instant,
@@ -29,15 +29,15 @@ struct Checker {
     /// The checks done: passed (with what they measured) or skipped.
     done: Vec<(Check, Option<String>)>,
     /// How the last stop went (`None`: none was sent).
-    last_stop: Option<Result<(), LinkError>>,
+    last_stop: Option<crate::check::StopRecord>,
     /// The check under way.
     current: Option<Check>,
 }
 
 impl Checker {
-    /// `Err` once a signal came: the bring-up fails its check and stops the chassis.
+    /// `Err` once the command must end: the bring-up fails its check and stops the chassis.
     fn go_on(&self) -> Result<(), LinkError> {
-        match signals::caught() {
+        match ending::ended() {
             Some(_) => Err(Error::Transport(embedded_io::ErrorKind::Interrupted)),
             None => Ok(()),
         }
@@ -90,9 +90,17 @@ impl Link for Checker {
         self.inner.set_velocity(velocity)
     }
     fn stop(&mut self) -> Result<(), LinkError> {
-        // Never refused: a signal is what a stop is for.
+        // Never refused, never cut short: an ending is what a stop is for.
+        let driver = self.inner.driver();
+        driver.uart_mut().uninterrupted();
+        let before = driver.uart().stops_sent();
         let result = self.inner.stop();
-        self.last_stop = Some(result);
+        let driver = self.inner.driver();
+        self.last_stop = Some(crate::check::StopRecord {
+            result,
+            sent: driver.uart().stops_sent() > before,
+            unheard: crate::stopping::unheard(driver),
+        });
         result
     }
     fn turn(&mut self, turn: Turn) -> Result<(), LinkError> {
@@ -279,10 +287,23 @@ pub fn not_run<T>(
         .collect()
 }
 
-/// What the bring-up's stop after a failure did, in words (`forced`: v1.0.0's forced stop;
-/// `why`: a driver error in words), for a failed check's line (both generations).
+/// What the check's last stop did: its result, whether the stop frame went out whole, and why
+/// the board is not known to have heard it (`None`: its frames were arriving).
+#[derive(Clone, Debug)]
+pub struct StopRecord {
+    /// The stop's result.
+    pub result: Result<(), LinkError>,
+    /// The stop frame was written whole.
+    pub sent: bool,
+    /// Why the board is not known to have heard it.
+    pub unheard: Option<String>,
+}
+
+/// What the stop after a failure did, as the end of the failure's line, from what was sent
+/// and what came back: "the chassis was stopped" only when the stop went out and the board's
+/// frames were arriving. `forced`: v1.0.0's forced stop; `why` words a driver error.
 pub fn stopped_words(
-    last_stop: Option<Result<(), LinkError>>,
+    last_stop: Option<StopRecord>,
     no_motion: bool,
     forced: bool,
     why: impl FnOnce(LinkError) -> String,
@@ -292,14 +313,25 @@ pub fn stopped_words(
     } else {
         ("stop", "")
     };
-    match (last_stop, no_motion) {
-        (_, true) => String::new(),
-        (Some(Ok(())), false) => format!("; the chassis was stopped{how}"),
-        (Some(Err(e)), false) => format!(
+    let Some(last) = last_stop.filter(|_| !no_motion) else {
+        return if no_motion {
+            String::new()
+        } else {
+            "; nothing had moved".into()
+        };
+    };
+    match (last.sent, last.result, last.unheard) {
+        (false, result, _) => format!(
             "; the {stop} could not be sent ({}): the chassis may still be moving, cut its power",
-            why(e)
+            result
+                .err()
+                .map_or_else(|| "nothing was written".into(), why)
         ),
-        (None, false) => "; nothing had moved".into(),
+        (true, Err(e), _) => format!("; the {stop} was sent but not confirmed: {}", why(e)),
+        (true, Ok(()), Some(unheard)) => {
+            format!("; the {stop} was sent but not confirmed: {unheard}")
+        }
+        (true, Ok(()), None) => format!("; the chassis was stopped{how}"),
     }
 }
 
@@ -322,7 +354,7 @@ pub struct Ending {
 /// Ends the progress line of the check under way and gives the failure's line and exit status:
 /// a signal's (128 + its number) if one ended the check, else the check's.
 pub fn ending(end: Ending) -> (String, u8) {
-    let interrupted = signals::caught();
+    let interrupted = ending::ended();
     if end.under_way {
         say!(
             "{}",
@@ -340,13 +372,13 @@ pub fn ending(end: Ending) -> (String, u8) {
     };
     let stopped = end.stopped;
     match interrupted {
-        Some(signal) => (
+        Some(why) => (
             format!(
-                "interrupted by {} during the {} check{stopped}{tail}",
-                signals::name(signal),
+                "{} during the {} check{stopped}{tail}",
+                why.words(),
                 end.check
             ),
-            signals::exit_status(signal),
+            why.exit_status(),
         ),
         None => (
             format!("FAIL: {}: {}{stopped}{tail}", end.check, end.why),
@@ -384,7 +416,6 @@ pub fn check(
     if !no_motion && !yes && !confirm(path, MOTION).map_err(failed)? {
         return Err(failed("check cancelled: nothing was sent".into()));
     }
-    signals::install().map_err(failed)?;
     let board: Board = port::open(path, None).map_err(failed)?;
     let (uart, clock, core) = board.release();
     let reader = clock.detached();

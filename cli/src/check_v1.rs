@@ -11,8 +11,8 @@
 
 use crate::check::{Ending, confirm, ending, not_run, stopped_words};
 use crate::device::core_words;
+use crate::ending;
 use crate::port::{self, BoardV1, Port, SharedClock};
-use crate::signals;
 use chassis_bringup::link::Blocking;
 use chassis_bringup::v1::{LinkV1, ReportV1, WhyV1, bring_up_v1};
 use chassis_bringup::{Check, Failure, LinkError, Note, Plan, Skip};
@@ -40,8 +40,8 @@ const fn name(check: Check) -> &'static str {
     }
 }
 
-/// The check's [`LinkV1`]: the host driver, with a progress line per check and the signals
-/// turned into an error at the next call (the bring-up then sends the forced stop itself).
+/// The check's [`LinkV1`]: the host driver, with a progress line per check and an ending (a
+/// signal, the terminal or input gone: [`crate::ending`]) turned into an error at the next call (the bring-up then sends the forced stop itself).
 struct CheckerV1 {
     inner: Blocking<Port, SharedClock, DriverCore>,
     start: Instant,
@@ -51,15 +51,15 @@ struct CheckerV1 {
     /// The checks done: passed (`true`) or skipped.
     done: Vec<(Check, bool)>,
     /// How the last forced stop went (`None`: none was sent).
-    last_stop: Option<Result<(), LinkError>>,
+    last_stop: Option<crate::check::StopRecord>,
     /// The check under way.
     current: Option<Check>,
 }
 
 impl CheckerV1 {
-    /// `Err` once a signal came: the bring-up fails its check and sends the forced stop.
+    /// `Err` once the command must end: the bring-up fails its check and sends the forced stop.
     fn go_on(&self) -> Result<(), LinkError> {
-        match signals::caught() {
+        match ending::ended() {
             Some(_) => Err(Error::Transport(embedded_io::ErrorKind::Interrupted)),
             None => Ok(()),
         }
@@ -86,9 +86,17 @@ impl LinkV1 for CheckerV1 {
         self.inner.set_velocity(velocity)
     }
     fn stop(&mut self) -> Result<(), LinkError> {
-        // Never refused: a signal is what a stop is for.
+        // Never refused, never cut short: an ending is what a stop is for.
+        let driver = self.inner.driver();
+        driver.uart_mut().uninterrupted();
+        let before = driver.uart().stops_sent();
         let result = LinkV1::stop(&mut self.inner);
-        self.last_stop = Some(result);
+        let driver = self.inner.driver();
+        self.last_stop = Some(crate::check::StopRecord {
+            result,
+            sent: driver.uart().stops_sent() > before,
+            unheard: crate::stopping::unheard(driver),
+        });
         result
     }
     fn readback(&mut self, readback: Readback) -> Result<Reply, LinkError> {
@@ -271,7 +279,6 @@ pub fn check(path: &str, no_motion: bool, yes: bool) -> Result<(), (String, u8)>
     if !no_motion && !yes && !confirm(path, MOTION).map_err(failed)? {
         return Err(failed("check cancelled: nothing was sent".into()));
     }
-    signals::install().map_err(failed)?;
     let board: BoardV1 = port::open_v1(path, None).map_err(failed)?;
     let (uart, clock, core) = board.release();
     let reader = clock.detached();

@@ -2,14 +2,17 @@
 //! host transport: get, set, settings, save, calibrate-gyro, stop, drive, turn.
 //!
 //! Every command that moves the chassis stops it on its way out, whatever ends it: done, an
-//! error, a board gone quiet, or SIGINT / SIGTERM / SIGHUP ([`crate::signals`]); a turn in
-//! progress is cancelled (the angle still pending is read and the opposite turn sent).
+//! error, a board gone quiet, SIGINT / SIGTERM / SIGHUP, its terminal or input gone
+//! ([`crate::ending`]); a turn in progress is cancelled (the angle still pending is read and
+//! the opposite turn sent). What it says of the chassis comes from what was sent and what came
+//! back ([`crate::stopping`]).
 
 use crate::encode::write_of;
+use crate::ending;
 use crate::names::{RegisterName, register_name};
 use crate::newfile::NewFile;
 use crate::port::{self, Board};
-use crate::signals;
+use crate::stopping::{self, Stopped};
 use chassis_protocol::driver::host::Heard;
 use chassis_protocol::driver::host::SerialError;
 use chassis_protocol::driver::{CoreError, Error, Outcome, Request, TurnState};
@@ -24,12 +27,7 @@ pub fn open(port: &str) -> Result<Board, String> {
 /// A driver error as one line, in the CLI's words. "Is it powered?" only when nothing at all
 /// came from the board.
 pub fn explain(driver: &Board, e: Error<SerialError>) -> String {
-    let port = driver.uart().name();
-    match e {
-        Error::Core(e) => core_words(e, driver.core().heard(driver.uart().now_ms()), port),
-        Error::Transport(e) => format!("serial port {port}: {}", e.0),
-        other => other.to_string(),
-    }
+    stopping::explain(driver, e)
 }
 
 /// The driver's logic error `e` in the CLI's words, told by what came from the board on
@@ -193,7 +191,7 @@ fn restored(file: &str, wanted: &Snapshot, board: &Snapshot) -> String {
 /// `chassis settings [--save FILE | --restore FILE]`.
 pub fn settings(port: &str, save: Option<&str>, restore: Option<&str>) -> Result<(), String> {
     if let Some(file) = restore {
-        let text = std::fs::read_to_string(file).map_err(|e| format!("cannot read {file}: {e}"))?;
+        let text = crate::input::read_text(file, crate::input::SETTINGS_MAX, "settings file")?;
         let snapshot: Snapshot = serde_json::from_str(&text).map_err(|e| {
             let v1 = serde_json::from_str::<serde_json::Value>(&text)
                 .is_ok_and(|v| v.get("firmware").and_then(|f| f.as_str()) == Some("v1.0.0"));
@@ -262,10 +260,34 @@ pub fn save(port: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// Polls the driver for `ms`, or until a signal comes.
+/// Why the driver's failsafe stopped the chassis (`did`: what it did), from what came from the
+/// board: nothing at all, bytes of another firmware, or frames that stopped.
+pub fn failsafe_words<K: stopping::Spoken>(driver: &stopping::HostDriver<K>, did: &str) -> String {
+    let heard = stopping::unheard(driver)
+        .unwrap_or_else(|| "the board's frames stopped for a while".into());
+    let hint = if driver.core().heard_at(driver.uart().now_ms()) == Heard::Nothing {
+        " (is it powered, TX wired to RX and RX to TX, at 115200 bps?)"
+    } else {
+        ""
+    };
+    format!("{heard}{hint}: the driver's failsafe {did}")
+}
+
+/// `Err` when the command must end before anything that moves the chassis is sent: nothing was.
+pub fn before_motion() -> Result<(), String> {
+    match ending::ended() {
+        Some(end) => Err(format!(
+            "{}: the chassis was not moved (nothing that moves it was sent)",
+            end.words()
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Polls the driver for `ms`, or until the command must end.
 fn poll_for(driver: &mut Board, ms: u64) -> Result<(), String> {
     let until = Instant::now() + Duration::from_millis(ms);
-    while Instant::now() < until && signals::caught().is_none() {
+    while Instant::now() < until && ending::ended().is_none() {
         if driver.poll().map_err(|e| explain(driver, e))?.is_none() {
             std::thread::sleep(Duration::from_millis(2));
         }
@@ -290,6 +312,14 @@ pub fn calibrate_gyro(port: &str) -> Result<(), String> {
     let start = Instant::now();
     let total = Duration::from_secs(30);
     while start.elapsed() < total {
+        if let Some(end) = ending::ended() {
+            bar.finish_and_clear();
+            let left = total.saturating_sub(start.elapsed()).as_secs_f64();
+            return Err(format!(
+                "{}: the board goes on calibrating for {left:.0} s more: keep the chassis still, then `chassis get gyro-calibration`",
+                end.words()
+            ));
+        }
         poll_for(&mut driver, 50)?;
         let s = start.elapsed().as_secs();
         bar.set_position(s);
@@ -306,35 +336,22 @@ pub fn calibrate_gyro(port: &str) -> Result<(), String> {
 }
 
 /// Stops the chassis (cancelling a turn) and says how the command ended: `ended` is what
-/// happened, `Ok` a line for stdout.
+/// happened (`Ok`: a line for stdout), the ending that cut it short comes first.
 fn stop_after(driver: &mut Board, ended: Result<String, String>) -> Result<String, String> {
-    let stopped = driver.stop().map_err(|e| explain(driver, e));
-    if let Some(signal) = signals::caught() {
-        return Err(match stopped {
-            Ok(()) => format!(
-                "interrupted by {}: the chassis was stopped{}",
-                signals::name(signal),
-                ended.err().map(|e| format!(" ({e})")).unwrap_or_default()
-            ),
-            Err(e) => format!(
-                "interrupted by {}: the stop was sent but not confirmed: {e}",
-                signals::name(signal)
-            ),
+    let stopped = stopping::stop(driver);
+    let words = stopped.words::<chassis_protocol::driver::DriverCore>();
+    if let Some(end) = ending::ended() {
+        let end = end.words();
+        // A wait the ending cut short says only the ending's words: not said twice.
+        return Err(match ended {
+            Err(detail) if !detail.contains(&end) => format!("{end}: {detail}; {words}"),
+            _ => format!("{end}: {words}"),
         });
     }
-    // A turn whose cancellation was not confirmed may still run on the board.
-    let pending = if driver.core().turn_state() == TurnState::Idle {
-        ""
-    } else {
-        " (the board may still have the turn pending: run `chassis stop` once it answers again)"
-    };
     match (ended, stopped) {
-        (Ok(line), Ok(())) => Ok(line),
-        (Err(e), Ok(())) => Err(format!("{e}; the chassis was stopped")),
-        (Ok(_), Err(e)) => Err(format!("the stop was sent but not confirmed: {e}{pending}")),
-        (Err(e), Err(s)) => Err(format!(
-            "{e}; the stop was sent but not confirmed: {s}{pending}"
-        )),
+        (Ok(line), Stopped::Confirmed) => Ok(line),
+        (Ok(line), _) => Err(format!("{line}, but {words}")),
+        (Err(e), _) => Err(format!("{e}; {words}")),
     }
 }
 
@@ -350,32 +367,54 @@ fn progress(len: u64, template: &str) -> indicatif::ProgressBar {
     bar
 }
 
-/// `chassis stop`: stops the chassis and cancels a turn the board still has pending (left by
-/// a program that was killed, say).
+/// `chassis stop`: stops the chassis at once, then reads the angle the board has pending and
+/// cancels a turn it finds (left by a program that was killed, say). The read's answer is the
+/// evidence that the board heard: without it, the stop is not said to have worked.
 pub fn stop(port: &str) -> Result<(), String> {
     let mut driver = open(port)?;
-    let pending = driver.turn_remaining();
-    let stopped = driver.stop().map_err(|e| explain(&driver, e));
-    match (pending, stopped) {
-        (Ok(left), Ok(())) if driver.core().turn_state() == TurnState::Idle => {
-            if left.unsigned_abs() > 5 {
-                say!(
-                    "stopped; the {:.1}° turn the board had pending was cancelled",
-                    f64::from(left) / 10.0
-                );
-            } else {
-                say!("stopped (no turn was pending)");
-            }
+    // Nothing cuts a stop short: it is what every ending asks for.
+    driver.uart_mut().uninterrupted();
+    let before = driver.uart().stops_sent();
+    let first = driver.stop();
+    if driver.uart().stops_sent() == before {
+        let why = first.err().map_or_else(
+            || "nothing was written".to_string(),
+            |e| explain(&driver, e),
+        );
+        return Err(format!(
+            "the stop could not be sent ({why}): the chassis may still be moving"
+        ));
+    }
+    let pending = match driver.turn_remaining() {
+        Ok(left) => left,
+        Err(e) => {
+            return Err(format!(
+                "the stop was sent, but the board did not answer the read after it: not confirmed, and whether a turn is pending is not known: {}",
+                explain(&driver, e)
+            ));
+        }
+    };
+    if !driver.core().turning() {
+        say!("stopped (the board answered; no turn was pending)");
+        return Ok(());
+    }
+    match driver.stop() {
+        Ok(()) if driver.core().turn_state() == TurnState::Idle => {
+            say!(
+                "stopped; the {:.1}° turn the board had pending was cancelled",
+                f64::from(pending) / 10.0
+            );
             Ok(())
         }
-        (Ok(_), Ok(())) => {
-            Err("the stop was sent, but the turn pending could not be cancelled: try again".into())
-        }
-        (Err(e), Ok(())) => Err(format!(
-            "the stop was sent, but whether a turn is pending is not known: {}",
+        Ok(()) => Err(format!(
+            "the stop was sent, but the {:.1}° turn the board has pending could not be cancelled: try again",
+            f64::from(pending) / 10.0
+        )),
+        Err(e) => Err(format!(
+            "the stop was sent, but the {:.1}° turn the board has pending was not cancelled: {}",
+            f64::from(pending) / 10.0,
             explain(&driver, e)
         )),
-        (_, Err(e)) => Err(format!("the stop was sent but not confirmed: {e}")),
     }
 }
 
@@ -386,8 +425,8 @@ pub fn drive(port: &str, velocity: Velocity, seconds: f64) -> Result<(), String>
     }
     // -0 is 0.
     let seconds = seconds + 0.0;
-    signals::install()?;
     let mut driver = open(port)?;
+    before_motion()?;
     let start = Instant::now();
     let end = start + Duration::from_secs_f64(seconds);
     let bar = progress(
@@ -397,8 +436,8 @@ pub fn drive(port: &str, velocity: Velocity, seconds: f64) -> Result<(), String>
     let ended = (|| -> Result<String, String> {
         let mut next = Instant::now();
         while Instant::now() < end {
-            if signals::caught().is_some() {
-                return Err("the drive was cut short".into());
+            if let Some(end) = ending::ended() {
+                return Err(end.words());
             }
             if Instant::now() >= next {
                 driver
@@ -408,13 +447,7 @@ pub fn drive(port: &str, velocity: Velocity, seconds: f64) -> Result<(), String>
             }
             poll_for(&mut driver, 5)?;
             if driver.core().failsafe_stops() > 0 {
-                return Err(if driver.core().last_heard_ms().is_none() {
-                    format!(
-                        "nothing came from the board on {port} (is it powered, TX wired to RX and RX to TX, at 115200 bps?): the driver's failsafe stopped it"
-                    )
-                } else {
-                    "the board went quiet while driving: the driver's failsafe stopped it".into()
-                });
+                return Err(failsafe_words(&driver, "stopped it"));
             }
             let done = start.elapsed().as_secs_f64().min(seconds);
             bar.set_position((done * 10.0) as u64);
@@ -439,8 +472,8 @@ pub fn turn(port: &str, degrees: f64) -> Result<(), String> {
         ));
     }
     let shown = f64::from(deci) / 10.0;
-    signals::install()?;
     let mut driver = open(port)?;
+    before_motion()?;
     match driver.turn_by(deci) {
         Ok(()) => {}
         Err(Error::Core(CoreError::TurnInProgress)) => {
@@ -451,6 +484,10 @@ pub fn turn(port: &str, degrees: f64) -> Result<(), String> {
             return Err(format!(
                 "the board still has {left:.1}° of an earlier turn pending (it adds turns up): not sent; wait for it to end, or `chassis stop` cancels it"
             ));
+        }
+        // Cut short before the turn went out (reading whether one is pending).
+        Err(_) if driver.core().turn_state() == TurnState::Unknown && ending::ended().is_some() => {
+            before_motion()?;
         }
         Err(e) if driver.core().turn_state() == TurnState::Unknown => {
             return Err(format!(
@@ -488,7 +525,7 @@ pub fn turn(port: &str, degrees: f64) -> Result<(), String> {
                 start.elapsed().as_secs_f64()
             ));
         }
-        if signals::caught().is_some() {
+        if ending::ended().is_some() {
             break Err(format!(
                 "the {shown:.1}° turn was sent and cancelled with {:.1}° left",
                 f64::from(left) / 10.0

@@ -36,13 +36,15 @@ mod check_v1;
 mod connect;
 mod device;
 mod encode;
+mod ending;
+mod input;
 mod monitor;
 mod names;
 mod newfile;
 mod port;
 mod record;
-mod signals;
 mod sim;
+mod stopping;
 mod v1cmd;
 mod value;
 
@@ -50,7 +52,7 @@ use chassis_capture as decode;
 use chassis_protocol::detect::Firmware;
 use clap::{Parser, Subcommand};
 use names::RegisterName;
-use std::io::{Read, Write};
+use std::io::Write;
 use std::process::ExitCode;
 
 /// The chassis motor-controller board's command-line tool.
@@ -258,8 +260,32 @@ impl DriveTypeName {
     }
 }
 
+impl Cmd {
+    /// What the command is, for the ways it can end early.
+    const fn kind(&self) -> ending::Kind {
+        match self {
+            Cmd::Decode { .. } | Cmd::Encode { .. } | Cmd::Sim { .. } => ending::Kind::NoBoard,
+            Cmd::Drive { .. }
+            | Cmd::Turn { .. }
+            | Cmd::Monitor { .. }
+            | Cmd::Check { .. }
+            | Cmd::Record { .. }
+            | Cmd::CalibrateGyro => ending::Kind::Lasting,
+            Cmd::Detect
+            | Cmd::Get { .. }
+            | Cmd::Set { .. }
+            | Cmd::Settings { .. }
+            | Cmd::Save
+            | Cmd::Stop => ending::Kind::Brief,
+        }
+    }
+}
+
 fn main() -> ExitCode {
+    // First: a signal at any moment from here on has its documented effect.
+    ending::catch_from_start();
     let cli = Cli::parse();
+    ending::for_command(cli.command.kind());
     let result = options(&cli).and_then(|()| match cli.command {
         Cmd::Check {
             no_motion,
@@ -293,7 +319,7 @@ fn main() -> ExitCode {
             .and_then(connect::detect_command),
         // A signal the command caught (and stopped the chassis for): 128 + its number, as a
         // shell reports a process the signal ended.
-        _ => run(cli).map_err(|e| (e, signals::caught().map_or(1, signals::exit_status))),
+        _ => run(cli).map_err(|e| (e, ending::ended().map_or(1, ending::Ending::exit_status))),
     });
     // A `--record` file never attached to a port is thrown away (what was there stays); one
     // that could not be written fails the command.
@@ -375,18 +401,9 @@ fn write_decoded(decoded: &decode::Decoded, format: decode::Format) -> Result<()
     }
 }
 
-/// The bytes of `file` (`None` or "-": standard input).
+/// The bytes of a capture (`None` or "-": standard input), at most [`input::CAPTURE_MAX`].
 fn read_input(file: Option<&str>) -> Result<Vec<u8>, String> {
-    match file {
-        None | Some("-") => {
-            let mut data = Vec::new();
-            std::io::stdin()
-                .read_to_end(&mut data)
-                .map_err(|e| format!("standard input: {e}"))?;
-            Ok(data)
-        }
-        Some(path) => std::fs::read(path).map_err(|e| format!("cannot read {path}: {e}")),
-    }
+    input::read(file, input::CAPTURE_MAX, "capture")
 }
 
 /// A 2020 register by its name on the command line.

@@ -15,8 +15,9 @@
 pub mod v1;
 
 use crate::device::{explain, open};
+use crate::ending;
 use crate::port::Board;
-use crate::signals;
+use crate::stopping;
 use chassis_protocol::driver::{CoreError, Error, Event as DriverEvent};
 use chassis_protocol::{Battery, Downlink, Encoders, Imu, Lock, Stream, Velocity};
 use ratatui::Frame;
@@ -52,6 +53,10 @@ pub trait Chassis {
 
     /// Sends the generation's stop (on the 2020 board a turn is cancelled too).
     fn stop(&mut self) -> Result<(), String>;
+
+    /// The stop on the way out, never cut short: `Ok` with what it did when the chassis is
+    /// known to have stopped, `Err` with what is known otherwise ([`stopping::stop`]).
+    fn stop_on_exit(&mut self) -> Result<String, String>;
 
     /// The rate the rotate keys (`z`, `x`) turn at, in the generation's z unit; or why there
     /// are none.
@@ -266,7 +271,7 @@ impl<C: Chassis> Monitor<C> {
     /// shown.
     pub fn tick(&mut self, ms: u64) {
         let until = Instant::now() + Duration::from_millis(ms);
-        while Instant::now() < until {
+        while Instant::now() < until && ending::ended().is_none() {
             match self.chassis.poll() {
                 Ok(true) => self.last_frame = Some(Instant::now()),
                 Ok(false) => std::thread::sleep(Duration::from_millis(1)),
@@ -377,19 +382,24 @@ impl<C: Chassis> Monitor<C> {
         })
     }
 
-    /// Stops the chassis (cancelling a turn) if this monitor drives it.
-    pub fn stop(&mut self) -> Result<(), String> {
+    /// The stop on the way out (cancelling a turn), if this monitor drives the chassis (`None`:
+    /// it only watches): [`Chassis::stop_on_exit`].
+    pub fn stop_on_exit(&mut self) -> Option<Result<String, String>> {
         if !self.drive {
-            return Ok(());
+            return None;
         }
         self.velocity = [0; 3];
-        self.chassis.stop()
+        Some(self.chassis.stop_on_exit())
     }
 }
 
 /// `chassis monitor [--drive]` over the board `open` opens (once the terminal is known to be
-/// one, and the signals are caught): draws until a quit key or a signal, then stops the
-/// chassis before giving the terminal back.
+/// one): draws until a quit key or an ending ([`crate::ending`]: a signal, the terminal gone),
+/// then stops the chassis before giving the terminal back.
+///
+/// The keys are read on a thread of their own: the loop that owns the driver never waits on
+/// the terminal, so a terminal that hangs up (whose reads then never block again) cannot keep
+/// it from stopping the chassis and ending.
 pub fn run_monitor<C: Chassis>(
     open: impl FnOnce() -> Result<C, String>,
     drive: bool,
@@ -401,37 +411,74 @@ pub fn run_monitor<C: Chassis>(
             "monitor draws on a terminal and reads its keys: run it in one (stdin and stdout a terminal, not a pipe or a file); `chassis record` captures without one".into(),
         );
     }
-    signals::install()?;
     let mut monitor = Monitor::new(open()?, drive, speed);
+    crate::device::before_motion()?;
     let mut terminal = ratatui::try_init().map_err(|e| format!("terminal: {e}"))?;
-    let result = monitor_loop(&mut terminal, &mut monitor);
+    let keys = read_keys();
+    let result = monitor_loop(&mut terminal, &mut monitor, &keys);
     // Stop before giving the terminal back, whatever happened.
-    let stopped = monitor.stop();
-    ratatui::restore();
-    if let Some(signal) = signals::caught() {
+    let stopped = monitor.stop_on_exit();
+    give_back(terminal);
+    if let Some(end) = ending::ended() {
         return Err(format!(
-            "interrupted by {}{}",
-            signals::name(signal),
-            match (drive, stopped) {
-                (false, _) => String::new(),
-                (true, Ok(())) => ": the chassis was stopped".into(),
-                (true, Err(e)) => format!(": the stop was sent but not confirmed: {e}"),
+            "{}{}",
+            end.words(),
+            match stopped {
+                None => String::new(),
+                Some(Ok(words) | Err(words)) => format!(": {words}"),
             }
         ));
     }
     result?;
-    stopped
+    match stopped {
+        Some(Err(words)) => Err(words),
+        _ => Ok(()),
+    }
+}
+
+/// Gives the terminal back as it was (raw mode off, the main screen, the cursor shown). A
+/// terminal that hung up takes none of it, and nothing is said of that (ratatui's own restore
+/// would print, and printing to a terminal gone panics).
+fn give_back(mut terminal: ratatui::DefaultTerminal) {
+    let _ = ratatui::try_restore();
+    if terminal.show_cursor().is_err() {
+        // Its drop would try again and print the failure.
+        std::mem::forget(terminal);
+    }
+}
+
+/// The terminal's events, read on a thread of its own: an error reading them is the last one
+/// sent.
+fn read_keys() -> std::sync::mpsc::Receiver<Result<Event, String>> {
+    let (send, keys) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        loop {
+            let event = event::read().map_err(|e| format!("terminal: {e}"));
+            let failed = event.is_err();
+            if send.send(event).is_err() || failed {
+                return;
+            }
+        }
+    });
+    keys
 }
 
 fn monitor_loop<C: Chassis>(
     terminal: &mut ratatui::DefaultTerminal,
     monitor: &mut Monitor<C>,
+    keys: &std::sync::mpsc::Receiver<Result<Event, String>>,
 ) -> Result<(), String> {
     let mut next_draw = Instant::now();
-    while signals::caught().is_none() {
+    while ending::ended().is_none() {
         monitor.tick(20);
-        while event::poll(Duration::ZERO).map_err(|e| format!("terminal: {e}"))? {
-            let event = event::read().map_err(|e| format!("terminal: {e}"))?;
+        loop {
+            let event = match keys.try_recv() {
+                Ok(event) => event?,
+                Err(std::sync::mpsc::TryRecvError::Empty) => break,
+                Err(std::sync::mpsc::TryRecvError::Disconnected) => {
+                    return Err("terminal: its keys can no longer be read".into());
+                }
+            };
             if let Some(key) = Key::of(&event) {
                 if !monitor.key(key) {
                     return Ok(());
@@ -727,6 +774,16 @@ impl Chassis for Board2020 {
 
     fn stop(&mut self) -> Result<(), String> {
         self.driver.stop().map_err(|e| explain(&self.driver, e))
+    }
+
+    fn stop_on_exit(&mut self) -> Result<String, String> {
+        let stopped = stopping::stop(&mut self.driver);
+        let words = stopped.words::<chassis_protocol::driver::DriverCore>();
+        if stopped.confirmed() {
+            Ok(words)
+        } else {
+            Err(words)
+        }
     }
 
     fn rotate_rate(&self) -> Result<i32, &'static str> {

@@ -71,13 +71,19 @@ pub fn record_to(path: &str) -> Result<(), String> {
 /// Opens `path` as a 2020 board's port with the host defaults; `record`, if given (or set by
 /// [`record_to`]), gets every byte both ways.
 pub fn open(path: &str, record: Option<Recorder>) -> Result<Board, String> {
-    let (port, clock) = open_port(path, record)?;
+    let (mut port, clock) = open_port(path, record)?;
+    port.stop = chassis_protocol::Velocity::STOP.encode().to_vec();
     Ok(Driver::new(port, clock, Config::HOST))
 }
 
 /// Opens `path` as a v1.0.0 board's port (as [`open`]).
 pub fn open_v1(path: &str, record: Option<Recorder>) -> Result<BoardV1, String> {
-    let (port, clock) = open_port(path, record)?;
+    let (mut port, clock) = open_port(path, record)?;
+    port.stop = chassis_protocol::v1::Command::BodyVelocity(
+        chassis_protocol::v1::BodyVelocity::FORCED_STOP,
+    )
+    .encode()
+    .to_vec();
     Ok(Driver::new_v1(port, clock, Config::HOST))
 }
 
@@ -99,6 +105,11 @@ pub fn open_port(path: &str, record: Option<Recorder>) -> Result<(Port, SharedCl
             path: path.to_string(),
             now: Rc::clone(&clock.last),
             record,
+            interruptible: true,
+            listener: None,
+            stop: Vec::new(),
+            stops: 0,
+            tail: Vec::with_capacity(TAIL),
         },
         clock,
     ))
@@ -131,14 +142,32 @@ pub fn open_serial(path: &str) -> Result<SerialPort, String> {
     })
 }
 
-/// The host serial port, with an optional recording of its bytes.
-#[derive(Debug)]
+/// What is shown every byte read from the board ([`Port::listen`]).
+type Listener = Box<dyn FnMut(&[u8])>;
+
+/// The last bytes written that a [`Port`] keeps: the longest frame of either generation.
+const TAIL: usize = 14;
+
+/// The host serial port, with an optional recording of its bytes. Its waits for a byte end
+/// with an error (kind `Interrupted`) once the command must end ([`crate::ending::ended`]), so
+/// that no read keeps a stop waiting; [`Port::uninterrupted`] lets what stops the chassis run
+/// to its end. It keeps what it wrote: what was sent is known, not assumed.
 pub struct Port {
     port: SerialPort,
     path: String,
     /// The driver's last clock reading, in ms.
     now: Rc<Cell<u64>>,
     record: Option<Recorder>,
+    /// Waits end when the command must.
+    interruptible: bool,
+    /// Shown every byte read from the board.
+    listener: Option<Listener>,
+    /// The generation's stop frame (empty: none counted).
+    stop: Vec<u8>,
+    /// Stop frames written whole so far.
+    stops: u64,
+    /// The last bytes written, the newest last (at most [`TAIL`]).
+    tail: Vec<u8>,
 }
 
 impl Port {
@@ -152,6 +181,24 @@ impl Port {
         self.now.get()
     }
 
+    /// From now on the port's waits run to their end whatever ends the command: what follows
+    /// stops the chassis.
+    pub fn uninterrupted(&mut self) {
+        self.interruptible = false;
+    }
+
+    /// From now on `listener` is shown every byte read from the board (`chassis record`
+    /// counts the frames of the other generation with it).
+    pub fn listen(&mut self, listener: impl FnMut(&[u8]) + 'static) {
+        self.listener = Some(Box::new(listener));
+    }
+
+    /// The generation's stop frames written whole to the port so far: the evidence that a
+    /// stop went out (a write that failed sent none).
+    pub fn stops_sent(&self) -> u64 {
+        self.stops
+    }
+
     /// The recording, if any.
     pub fn recorder(&self) -> Option<&Recorder> {
         self.record.as_ref()
@@ -163,12 +210,31 @@ impl Port {
     }
 }
 
+impl std::fmt::Debug for Port {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Port")
+            .field("path", &self.path)
+            .field("record", &self.record)
+            .field("interruptible", &self.interruptible)
+            .field("stops", &self.stops)
+            .finish_non_exhaustive()
+    }
+}
+
 impl embedded_io::ErrorType for Port {
     type Error = SerialError;
 }
 
 impl embedded_io::ReadReady for Port {
     fn read_ready(&mut self) -> Result<bool, SerialError> {
+        if self.interruptible {
+            if let Some(ending) = crate::ending::ended() {
+                return Err(SerialError(std::io::Error::new(
+                    std::io::ErrorKind::Interrupted,
+                    ending.words(),
+                )));
+            }
+        }
         let ready = self.port.read_ready()?;
         if let (false, Some(record)) = (ready, self.record.as_mut()) {
             record.nothing_waiting(self.now.get());
@@ -180,8 +246,12 @@ impl embedded_io::ReadReady for Port {
 impl embedded_io::Read for Port {
     fn read(&mut self, buf: &mut [u8]) -> Result<usize, SerialError> {
         let n = self.port.read(buf)?;
-        if let (Some(record), Some(bytes)) = (self.record.as_mut(), buf.get(..n)) {
+        let bytes = buf.get(..n).unwrap_or_default();
+        if let Some(record) = self.record.as_mut() {
             record.board(bytes, self.now.get());
+        }
+        if let Some(listener) = self.listener.as_mut() {
+            listener(bytes);
         }
         Ok(n)
     }
@@ -190,8 +260,18 @@ impl embedded_io::Read for Port {
 impl embedded_io::Write for Port {
     fn write(&mut self, buf: &[u8]) -> Result<usize, SerialError> {
         let n = self.port.write(buf)?;
-        if let (Some(record), Some(bytes)) = (self.record.as_mut(), buf.get(..n)) {
+        let bytes = buf.get(..n).unwrap_or_default();
+        if let Some(record) = self.record.as_mut() {
             record.master(bytes, self.now.get());
+        }
+        for &byte in bytes {
+            if self.tail.len() == TAIL {
+                self.tail.remove(0);
+            }
+            self.tail.push(byte);
+            if !self.stop.is_empty() && self.tail.ends_with(&self.stop) {
+                self.stops = self.stops.saturating_add(1);
+            }
         }
         Ok(n)
     }

@@ -1,12 +1,16 @@
 //! `chassis record`: what the board sends, time-stamped, into a file `chassis decode` reads
 //! back exactly (a Saleae Logic 2 export: quiet lines are gaps in the time stamps, 40 ms as
 //! the host driver judges them: `--quiet-ms 40`). Sends
-//! nothing. Ends after `--for`, or on Ctrl-C (SIGINT, SIGTERM, SIGHUP) with the file complete.
+//! nothing. Ends after `--for`, or on Ctrl-C (SIGINT, SIGTERM, SIGHUP) or its terminal or
+//! input gone ([`crate::ending`]), with the file complete. The frames of both firmware
+//! generations are counted (it sends nothing, so it never asks which).
 
 use crate::device::explain;
+use crate::ending;
 use crate::port::{self, Recorder};
-use crate::signals;
 use chassis_protocol::driver::Event;
+use std::cell::Cell;
+use std::rc::Rc;
 use std::time::{Duration, Instant};
 
 /// `chassis record --out FILE [--for SECONDS]`.
@@ -18,10 +22,20 @@ pub fn record(path: &str, out: &str, seconds: Option<f64>) -> Result<(), String>
             ));
         }
     }
-    signals::install()?;
     // The file first: a path that cannot be written fails before the port is touched.
     let recorder = Recorder::create(out)?;
     let mut driver = port::open(path, Some(recorder))?;
+    // The 2020 frames are the driver's; the v1.0.0 ones are counted beside it.
+    let v1_frames = Rc::new(Cell::new(0u64));
+    let count = Rc::clone(&v1_frames);
+    let mut v1 = chassis_protocol::v1::DownlinkParser::new();
+    driver.uart_mut().listen(move |bytes| {
+        for &byte in bytes {
+            if v1.push(byte).is_some() {
+                count.set(count.get().saturating_add(1));
+            }
+        }
+    });
     let bar = indicatif::ProgressBar::with_draw_target(
         None,
         indicatif::ProgressDrawTarget::stderr_with_hz(5),
@@ -35,11 +49,13 @@ pub fn record(path: &str, out: &str, seconds: Option<f64>) -> Result<(), String>
     let end = seconds.map(|s| start + Duration::from_secs_f64(s));
     let mut frames = 0u64;
     let mut error = None;
-    while signals::caught().is_none() && end.is_none_or(|end| Instant::now() < end) {
+    while ending::ended().is_none() && end.is_none_or(|end| Instant::now() < end) {
         match driver.poll() {
             Ok(Some(Event::Telemetry(_) | Event::Reply(_) | Event::StrayReply(_))) => frames += 1,
             // The poll waited up to a millisecond for a byte.
             Ok(None) => {}
+            // A wait the ending cut short: the recording ends as it would on Ctrl-C.
+            Err(_) if ending::ended().is_some() => break,
             Err(e) => {
                 error = Some(explain(&driver, e));
                 break;
@@ -50,7 +66,8 @@ pub fn record(path: &str, out: &str, seconds: Option<f64>) -> Result<(), String>
             .recorder()
             .map_or(0, |r| r.counts().board_bytes);
         bar.set_message(format!(
-            "{frames} frames, {bytes} bytes, {:.0} s",
+            "{} frames, {bytes} bytes, {:.0} s",
+            frames + v1_frames.get(),
             start.elapsed().as_secs_f64()
         ));
     }
@@ -59,6 +76,7 @@ pub fn record(path: &str, out: &str, seconds: Option<f64>) -> Result<(), String>
         .uart_mut()
         .finish_recording()
         .unwrap_or(Ok(port::Counts::default()))?;
+    let frames = frames + v1_frames.get();
     let summary = format!(
         "recorded {} bytes from the board ({frames} frames) in {:.1} s to {out}; read it back: chassis decode {out} --input saleae-csv --quiet-ms 40",
         counts.board_bytes,

@@ -5,10 +5,12 @@
 //! whole-frame guarantee. What v1.0.0 has no frame for (a turn by an angle, storing in flash, a
 //! gyro calibration) is refused in one line.
 
+use crate::ending;
 use crate::port::{self, BoardV1};
-use crate::signals;
+use crate::stopping::{self, Stopped};
 use chassis_protocol::driver::Error;
 use chassis_protocol::driver::host::SerialError;
+use chassis_protocol::driver::v1::DriverCore;
 use chassis_protocol::driver::v1::Settings;
 use chassis_protocol::v1::{
     BodyVelocity, FIELDS, FieldError, Geometry, Pid, Readback, Reply, SystemSettings,
@@ -25,13 +27,7 @@ pub fn names() -> String {
 
 /// A driver error as one line, in the CLI's words.
 fn explain(driver: &BoardV1, e: Error<SerialError>) -> String {
-    let port = driver.uart().name();
-    let heard = driver.core().heard(driver.uart().now_ms());
-    match e {
-        Error::Core(e) => crate::device::core_words(e, heard, port),
-        Error::Transport(e) => format!("serial port {port}: {}", e.0),
-        other => other.to_string(),
-    }
+    stopping::explain(driver, e)
 }
 
 /// One readback.
@@ -132,7 +128,7 @@ enum Mark {
 /// `chassis settings [--save FILE | --restore FILE]` on v1.0.0.
 pub fn settings(path: &str, save: Option<&str>, restore: Option<&str>) -> Result<(), String> {
     if let Some(file) = restore {
-        let text = std::fs::read_to_string(file).map_err(|e| format!("cannot read {file}: {e}"))?;
+        let text = crate::input::read_text(file, crate::input::SETTINGS_MAX, "settings file")?;
         let saved: Saved = serde_json::from_str(&text).map_err(|e| {
             format!("{file} is not a v1.0.0 settings file (`chassis settings --save` on a v1.0.0 board writes one): {e}")
         })?;
@@ -183,12 +179,53 @@ pub fn settings(path: &str, save: Option<&str>, restore: Option<&str>) -> Result
     Ok(())
 }
 
-/// `chassis stop` on v1.0.0: the forced stop.
+/// How long `chassis stop` waits for the board's telemetry after the forced stop (it sends a
+/// frame every 39-47 ms).
+const STOP_EVIDENCE: Duration = Duration::from_millis(300);
+
+/// `chassis stop` on v1.0.0: the forced stop, then the board's next telemetry frame as the
+/// evidence that it is there (its velocity said); without one, the stop is not said to have
+/// worked.
 pub fn stop(path: &str) -> Result<(), String> {
     let mut driver = port::open_v1(path, None)?;
-    driver.stop().map_err(|e| explain(&driver, e))?;
-    say!("stopped (the forced stop was sent)");
-    Ok(())
+    let stopped = stopping::stop(&mut driver);
+    if let Stopped::NotSent(_) = stopped {
+        return Err(stopped.words::<DriverCore>());
+    }
+    let sent_at = driver.uart().now_ms();
+    let until = Instant::now() + STOP_EVIDENCE;
+    while Instant::now() < until {
+        if let Err(e) = driver.poll() {
+            return Err(format!(
+                "the forced stop was sent, but not confirmed: {}",
+                explain(&driver, e)
+            ));
+        }
+        if let Some(t) = driver.core().telemetry().filter(|t| t.at_ms > sent_at) {
+            let [vx, vy, wz] = t.value.velocity;
+            if [vx, vy, wz] == [0; 3] {
+                say!(
+                    "stopped (the forced stop was sent; the board's next frame reports it standing still)"
+                );
+            } else {
+                say!(
+                    "the forced stop was sent; the board's next frame still reports vx {} m/s, vy {} m/s, wz {} rad/s (slowing down?)",
+                    f64::from(vx) / 1000.0,
+                    f64::from(vy) / 1000.0,
+                    f64::from(wz) / 1000.0
+                );
+            }
+            return Ok(());
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    Err(format!(
+        "the forced stop was sent but not confirmed: {}",
+        stopping::unheard(&driver).unwrap_or_else(|| format!(
+            "no frame came from the board within {} ms after it",
+            STOP_EVIDENCE.as_millis()
+        ))
+    ))
 }
 
 /// A speed in m/s (or rad/s) as the board's thousandths, range-checked.
@@ -215,15 +252,15 @@ pub fn drive(path: &str, velocity: BodyVelocity, seconds: f64) -> Result<(), Str
         return Err(format!("--for: {seconds} s is out of range (0..=600)"));
     }
     let seconds = seconds + 0.0;
-    signals::install()?;
     let mut driver = port::open_v1(path, None)?;
+    crate::device::before_motion()?;
     let start = Instant::now();
     let end = start + Duration::from_secs_f64(seconds);
     let ended = (|| -> Result<String, String> {
         let mut next = Instant::now();
         while Instant::now() < end {
-            if signals::caught().is_some() {
-                return Err("the drive was cut short".into());
+            if let Some(end) = ending::ended() {
+                return Err(end.words());
             }
             if Instant::now() >= next {
                 driver
@@ -235,37 +272,25 @@ pub fn drive(path: &str, velocity: BodyVelocity, seconds: f64) -> Result<(), Str
                 std::thread::sleep(Duration::from_millis(2));
             }
             if driver.core().failsafe_stops() > 0 {
-                return Err(if driver.core().last_heard_ms().is_none() {
-                    format!(
-                        "nothing came from the board on {path} (is it powered, TX wired to RX and RX to TX, at 115200 bps?): the driver's failsafe sent the forced stop"
-                    )
-                } else {
-                    "the board went quiet while driving: the driver's failsafe sent the forced stop"
-                        .into()
-                });
+                return Err(crate::device::failsafe_words(
+                    &driver,
+                    "sent the forced stop",
+                ));
             }
         }
         Ok(format!("drove {seconds} s, stopped (forced stop)"))
     })();
-    let stopped = driver.stop().map_err(|e| explain(&driver, e));
-    if let Some(signal) = signals::caught() {
-        return Err(match stopped {
-            Ok(()) => format!(
-                "interrupted by {}: the chassis was stopped (the forced stop was sent)",
-                signals::name(signal)
-            ),
-            Err(e) => format!(
-                "interrupted by {}: the forced stop could not be sent: {e}",
-                signals::name(signal)
-            ),
-        });
+    let stopped = stopping::stop(&mut driver);
+    let words = stopped.words::<DriverCore>();
+    if let Some(end) = ending::ended() {
+        return Err(format!("{}: {words}", end.words()));
     }
     match (ended, stopped) {
-        (Ok(line), Ok(())) => {
+        (Ok(line), Stopped::Confirmed) => {
             say!("{line}");
             Ok(())
         }
-        (Err(e), Ok(())) => Err(format!("{e}; the chassis was stopped")),
-        (_, Err(e)) => Err(format!("the forced stop could not be sent: {e}")),
+        (Ok(line), _) => Err(format!("{line}, but {words}")),
+        (Err(e), _) => Err(format!("{e}; {words}")),
     }
 }

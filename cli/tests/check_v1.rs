@@ -176,7 +176,11 @@ fn a_v1_board_gone_quiet_during_the_check_fails_it_and_gets_the_forced_stop() {
         stderr.contains("went quiet") || stderr.contains("no telemetry"),
         "{stderr}"
     );
-    assert!(stderr.contains("the chassis was stopped"), "{stderr}");
+    assert!(
+        stderr.contains("the forced stop was sent but not confirmed"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("the chassis was stopped"), "{stderr}");
     let (board, heard) = board.finish();
     assert_eq!(frames(&heard).last(), Some(&FORCED_STOP));
     assert_eq!(board.velocity(), BodyVelocity::FORCED_STOP);

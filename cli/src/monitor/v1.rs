@@ -196,10 +196,7 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
 
 /// A driver error as one line, in the CLI's words.
 fn explain(driver: &BoardV1, e: Error<SerialError>) -> String {
-    match e {
-        Error::Transport(e) => format!("serial port {}: {}", driver.uart().name(), e.0),
-        other => other.to_string(),
-    }
+    crate::stopping::explain(driver, e)
 }
 
 /// A velocity component as the frame's 16 bits (the keys never go past ±2000).
@@ -246,6 +243,16 @@ impl Chassis for BoardV1Chassis {
 
     fn stop(&mut self) -> Result<(), String> {
         self.driver.stop().map_err(|e| explain(&self.driver, e))
+    }
+
+    fn stop_on_exit(&mut self) -> Result<String, String> {
+        let stopped = crate::stopping::stop(&mut self.driver);
+        let words = stopped.words::<chassis_protocol::driver::v1::DriverCore>();
+        if stopped.confirmed() {
+            Ok(words)
+        } else {
+            Err(words)
+        }
     }
 
     fn rotate_rate(&self) -> Result<i32, &'static str> {

@@ -17,6 +17,24 @@ use std::time::{Duration, Instant};
 /// The stop frame, from the spec's table 1A: velocity mode, X = Y = Z = 0, no direction bits.
 pub const STOP: [u8; 10] = [0xFF, 0xFE, 0x01, 0, 0, 0, 0, 0, 0, 0];
 
+/// The `chassis` binary under test: this package's, or the one `CHASSIS_BIN` names (the same
+/// tests against another build: a release binary, an older commit).
+pub fn bin() -> String {
+    std::env::var("CHASSIS_BIN").unwrap_or_else(|_| env!("CARGO_BIN_EXE_chassis").to_string())
+}
+
+/// A pseudo-terminal pair, neither end passed on to the commands the test starts (a command
+/// holding the other end would keep the line, or its terminal, from ever hanging up).
+pub fn pty_pair() -> (TTYPort, TTYPort) {
+    use nix::fcntl::{FcntlArg, FdFlag, fcntl};
+    use std::os::fd::AsRawFd;
+    let (a, b) = TTYPort::pair().expect("a pseudo-terminal");
+    for end in [&a, &b] {
+        fcntl(end.as_raw_fd(), FcntlArg::F_SETFD(FdFlag::FD_CLOEXEC)).expect("FD_CLOEXEC");
+    }
+    (a, b)
+}
+
 /// The board's end of the line: records what it reads, drops what it writes while silent,
 /// drops the next `drop_replies` replies of the pending angle (`23 20 …`).
 struct Tap {
@@ -88,7 +106,7 @@ impl TestBoard {
 impl<B: Simulated + Send + 'static> TestBoard<B> {
     /// `board`, served.
     pub fn serving(board: B) -> TestBoard<B> {
-        let (mut board_end, path_end) = TTYPort::pair().expect("a pseudo-terminal");
+        let (mut board_end, path_end) = pty_pair();
         board_end.set_timeout(Duration::from_millis(1)).unwrap();
         let path = path_end.name().expect("its path");
         let stop = Arc::new(AtomicBool::new(false));
@@ -140,7 +158,7 @@ impl<B: Simulated + Send + 'static> TestBoard<B> {
     pub fn spawn(&self, args: &[&str]) -> Child {
         let mut all = vec!["--port", self.path.as_str()];
         all.extend_from_slice(args);
-        Process::new(env!("CARGO_BIN_EXE_chassis"))
+        Process::new(bin())
             .args(&all)
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
@@ -238,7 +256,7 @@ pub fn assert_stopped(board: &Board, heard: &[u8]) {
 
 /// `chassis args`, run to its end.
 pub fn chassis(args: &[&str]) -> Output {
-    Process::new(env!("CARGO_BIN_EXE_chassis"))
+    Process::new(bin())
         .args(args)
         .stdin(Stdio::null())
         .output()
@@ -280,7 +298,7 @@ pub fn wait(child: Child, secs: u64) -> Output {
 pub struct Terminal {
     /// The command.
     pub child: Child,
-    master: TTYPort,
+    master: Option<TTYPort>,
     screen: Arc<Mutex<Vec<u8>>>,
     reader: Option<JoinHandle<()>>,
     done: Arc<AtomicBool>,
@@ -289,7 +307,7 @@ pub struct Terminal {
 impl Terminal {
     /// Starts `chassis args` with its stdin, stdout and stderr on a new terminal.
     pub fn spawn(args: &[&str]) -> Terminal {
-        let (master, slave) = TTYPort::pair().expect("a pseudo-terminal");
+        let (master, slave) = pty_pair();
         let path = slave.name().unwrap();
         let open = || {
             std::fs::OpenOptions::new()
@@ -305,7 +323,7 @@ impl Terminal {
             .unwrap()
             .success();
         assert!(ok, "stty sets the terminal's size");
-        let child = Process::new(env!("CARGO_BIN_EXE_chassis"))
+        let child = Process::new(bin())
             .args(args)
             .stdin(open())
             .stdout(open())
@@ -331,7 +349,7 @@ impl Terminal {
         });
         Terminal {
             child,
-            master,
+            master: Some(master),
             screen,
             reader: Some(reader),
             done,
@@ -368,8 +386,20 @@ impl Terminal {
 
     /// Types `keys`.
     pub fn press(&mut self, keys: &[u8]) {
-        self.master.write_all(keys).unwrap();
-        self.master.flush().unwrap();
+        let master = self.master.as_mut().expect("the terminal is open");
+        master.write_all(keys).unwrap();
+        master.flush().unwrap();
+    }
+
+    /// Closes the terminal under the command, as a terminal window closed or an ssh session
+    /// dropped does (the command is not the session's leader: no SIGHUP comes from the
+    /// kernel; its terminal hangs up, reads end and writes fail).
+    pub fn close(&mut self) {
+        self.done.store(true, Ordering::SeqCst);
+        if let Some(r) = self.reader.take() {
+            let _ = r.join();
+        }
+        self.master = None;
     }
 
     /// Waits (up to `secs`) for the command to end: its exit status.
@@ -477,7 +507,7 @@ impl TestBoard {
 
 /// `chassis sim --pty EXTRA…` in the background: the process and the path it serves.
 pub fn sim_pty(extra: &[&str]) -> (Child, String) {
-    let mut child = Process::new(env!("CARGO_BIN_EXE_chassis"))
+    let mut child = Process::new(bin())
         .args(["sim", "--pty"])
         .args(extra)
         .stdout(Stdio::piped())
@@ -506,7 +536,7 @@ pub struct OtherDevice {
 impl OtherDevice {
     /// Starts talking.
     pub fn start() -> OtherDevice {
-        let (mut device_end, path_end) = TTYPort::pair().expect("a pseudo-terminal");
+        let (mut device_end, path_end) = pty_pair();
         device_end.set_timeout(Duration::from_millis(1)).unwrap();
         let path = path_end.name().expect("its path");
         let stop = Arc::new(AtomicBool::new(false));

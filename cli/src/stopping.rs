@@ -1,0 +1,136 @@
+//! Stopping the chassis on a command's way out, and saying only what is known of it: what went
+//! out (the port counts the stop frames it wrote whole) and what came back (the board's frames).
+//! "The chassis was stopped" is said only when the stop went out and the board's frames were
+//! arriving; a stop whose write failed is never said to have been sent.
+
+use crate::port::{Port, SharedClock};
+use chassis_protocol::driver::blocking::Driver;
+use chassis_protocol::driver::host::{Heard, SerialError, words_heard};
+use chassis_protocol::driver::{Core, DriverCore, Error, TurnState, v1};
+
+/// What the CLI needs of a generation's driver core to say what a stop did.
+pub trait Spoken: Core {
+    /// The stop frame's name: "the stop", "the forced stop".
+    const STOP: &'static str;
+    /// The firmware's name: "2020", "v1.0.0".
+    const FIRMWARE: &'static str;
+    /// What has come from the board, judged at `now_ms`.
+    fn heard_at(&self, now_ms: u64) -> Heard;
+    /// A turn the board may still have pending (a cancellation not confirmed).
+    fn turn_unsettled(&self) -> bool {
+        false
+    }
+}
+
+impl Spoken for DriverCore {
+    const STOP: &'static str = "the stop";
+    const FIRMWARE: &'static str = "2020";
+    fn heard_at(&self, now_ms: u64) -> Heard {
+        self.heard(now_ms)
+    }
+    fn turn_unsettled(&self) -> bool {
+        // `Unknown` is a turn nobody sent here: it is no reason to speak of one.
+        matches!(self.turn_state(), TurnState::Turning { .. })
+    }
+}
+
+impl Spoken for v1::DriverCore {
+    const STOP: &'static str = "the forced stop";
+    const FIRMWARE: &'static str = "v1.0.0";
+    fn heard_at(&self, now_ms: u64) -> Heard {
+        self.heard(now_ms)
+    }
+}
+
+/// A host driver of either generation over the CLI's port.
+pub type HostDriver<K> = Driver<Port, SharedClock, K>;
+
+/// A driver error as one line, in the CLI's words. "Is it powered?" only when nothing at all
+/// came from the board.
+pub fn explain<K: Spoken>(driver: &HostDriver<K>, e: Error<SerialError>) -> String {
+    let port = driver.uart().name();
+    match e {
+        Error::Core(e) => words_heard(e, driver.core().heard_at(driver.uart().now_ms()), port),
+        Error::Transport(e) => format!("serial port {port}: {}", e.0),
+        other => other.to_string(),
+    }
+}
+
+/// What a stop did.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Stopped {
+    /// The stop went out whole and the board's frames were arriving (a turn's cancellation
+    /// confirmed).
+    Confirmed,
+    /// The stop went out whole; why that is all that is known.
+    Unconfirmed(String),
+    /// No stop went out: why.
+    NotSent(String),
+}
+
+impl Stopped {
+    /// Whether the chassis is known to have been stopped.
+    pub fn confirmed(&self) -> bool {
+        *self == Stopped::Confirmed
+    }
+
+    /// What the stop did, for a person: "the chassis was stopped", "the stop was sent but not
+    /// confirmed: …", "the stop could not be sent (…): …".
+    pub fn words<K: Spoken>(&self) -> String {
+        match self {
+            Stopped::Confirmed => "the chassis was stopped".into(),
+            Stopped::Unconfirmed(why) => format!("{} was sent but not confirmed: {why}", K::STOP),
+            Stopped::NotSent(why) => format!(
+                "{} could not be sent ({why}): the chassis may still be moving; run `chassis stop` once the port is back",
+                K::STOP
+            ),
+        }
+    }
+}
+
+/// Stops the chassis (on the 2020 firmware cancelling a turn), the port's waits no longer cut
+/// short by the command's ending: what the stop did, from what was sent and what came back.
+pub fn stop<K: Spoken>(driver: &mut HostDriver<K>) -> Stopped {
+    driver.uart_mut().uninterrupted();
+    let before = driver.uart().stops_sent();
+    let result = driver.stop();
+    let sent = driver.uart().stops_sent() > before;
+    match result {
+        Err(e) if !sent => Stopped::NotSent(explain(driver, e)),
+        Err(e) => Stopped::Unconfirmed(format!("{}{}", explain(driver, e), pending_turn(driver))),
+        Ok(()) if !sent => Stopped::NotSent("nothing was written".into()),
+        Ok(()) if driver.core().turn_unsettled() => {
+            Stopped::Unconfirmed(pending_turn(driver).trim_start_matches("; ").into())
+        }
+        Ok(()) => match unheard(driver) {
+            None => Stopped::Confirmed,
+            Some(why) => Stopped::Unconfirmed(why),
+        },
+    }
+}
+
+/// Why the board is not known to have heard: `None` when its frames are arriving.
+pub fn unheard<K: Spoken>(driver: &HostDriver<K>) -> Option<String> {
+    let port = driver.uart().name();
+    match driver.core().heard_at(driver.uart().now_ms()) {
+        Heard::Frames => None,
+        Heard::Quiet => Some(format!(
+            "the board on {port} went quiet (no frame within the failsafe time)"
+        )),
+        Heard::NoFrame => Some(format!(
+            "bytes came from {port}, but no frame of the {} firmware (the other firmware? `chassis detect` tells)",
+            K::FIRMWARE
+        )),
+        Heard::Nothing => Some(format!("nothing came from the board on {port}")),
+    }
+}
+
+/// "; the board may still have the turn pending: …" when a cancellation was not confirmed.
+fn pending_turn<K: Spoken>(driver: &HostDriver<K>) -> String {
+    if driver.core().turn_unsettled() {
+        "; the board may still have the turn pending: run `chassis stop` once it answers again"
+            .into()
+    } else {
+        String::new()
+    }
+}
