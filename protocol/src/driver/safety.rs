@@ -8,8 +8,9 @@
 //!   rest in the core, and whatever is sent next starts by finishing it: the board's parser never
 //!   sees the start of one frame completed by another.
 //! * **The failsafe.** While the chassis is moving, no frame heard from the board for
-//!   `failsafe_ms` (or `settings_pause_ms` after a settings frame, until telemetry is back)
-//!   queues the wire format's stop frame ([`Wire::stop`]), ahead of anything else not yet begun.
+//!   `failsafe_ms` (or `settings_pause_ms` after a settings frame, until telemetry is back; a
+//!   read counts once the board has answered it) queues the wire format's stop
+//!   frame ([`Wire::stop`]), ahead of anything else not yet begun.
 //! * **Time** is the core's own monotonic milliseconds ([`Timebase`]): a `u32` tick counter that
 //!   wraps, or a clock that goes back, never stops the failsafe or hangs a wait.
 //! * **Bounded waits.** A request's wait ends after a stated number of pump turns that see the
@@ -62,8 +63,12 @@ pub(crate) struct Safety<W: Wire> {
     /// The last frame of any kind (telemetry or reply): the board is alive.
     last_heard_ms: Option<u64>,
     last_telemetry_ms: Option<u64>,
-    /// The last settings frame sent: the board may pause its telemetry after it.
+    /// The last settings frame sent (a read's once answered): the board may pause its
+    /// telemetry after it.
     settings_sent_ms: Option<u64>,
+    /// When the last read went: the low 32 bits of the core's time (its reply comes well
+    /// within 2^32 ms).
+    read_sent_low: u32,
     /// Telemetry frames heard since the last settings frame (saturating at 255).
     telemetry_after_settings: u8,
     moving_since_ms: Option<u64>,
@@ -85,6 +90,7 @@ impl<W: Wire> Safety<W> {
             last_heard_ms: None,
             last_telemetry_ms: None,
             settings_sent_ms: None,
+            read_sent_low: 0,
             telemetry_after_settings: 0,
             moving_since_ms: None,
             failsafe_stops: 0,
@@ -140,9 +146,15 @@ impl<W: Wire> Safety<W> {
 
     /// Puts `frame` in the free slot (the caller checked [`slot_free`](Self::slot_free)).
     pub(crate) fn load(&mut self, frame: W::Frame, kind: FrameKind) {
-        // The board pauses its telemetry while settings are made, reads included (A13).
-        if matches!(kind, FrameKind::Settings | FrameKind::Read) {
-            self.settings_sent(self.now());
+        // The board pauses its telemetry while settings are made, reads included (A13). A
+        // write or an action is answered by nothing: its pause is allowed from when it goes. A
+        // read's is allowed from when it went, once its reply comes (`reply_heard`): a board
+        // that answers no read is silent, not paused, and reads sent to it never hold the
+        // failsafe off.
+        match kind {
+            FrameKind::Settings => self.settings_sent(self.now()),
+            FrameKind::Read => self.read_sent_low = self.now() as u32,
+            FrameKind::Motion => {}
         }
         self.tx = Some(InFlight {
             frame,
@@ -226,7 +238,11 @@ impl<W: Wire> Safety<W> {
     /// (and paused), so it says nothing about the pause being over.
     pub(crate) fn reply_heard(&mut self, at_ms: u64) {
         self.heard(at_ms);
-        self.telemetry_after_settings = 0;
+        // The board answered: it took the last read, and may pause its telemetry from then.
+        let since_read = u64::from((at_ms as u32).wrapping_sub(self.read_sent_low));
+        let read = at_ms.saturating_sub(since_read);
+        let since = self.settings_sent_ms.map_or(read, |t| t.max(read));
+        self.settings_sent(since);
     }
 
     /// When the last frame of any kind was heard.

@@ -1673,6 +1673,42 @@ mod tests {
     }
 
     #[test]
+    fn reads_a_silent_board_leaves_unanswered_never_hold_the_failsafe_off() {
+        // The pause idle_core's answered read allows (600 ms from 0) over, the board heard at
+        // 700, moving, then silent; a read started again as soon as one gives up (another
+        // thread's loop): the stop still comes failsafe_ms after the board was last heard.
+        let mut core = idle_core();
+        reply(&mut core, Register::MaxSpeed, 1_000, 700);
+        // Moving from the core's time now (the reply was taken in at 705, on a quiet line).
+        let heard = core.now_ms();
+        let mut now = heard;
+        core.velocity(Velocity::new(0, 100, 0), now).unwrap();
+        assert!(out(&mut core, now).is_some());
+        let mut stopped = None;
+        while now < 2_000 && stopped.is_none() {
+            if !core.busy() {
+                core.start(Request::Read(Register::MotorVoltage)).unwrap();
+            }
+            for _ in 0..20 {
+                now += 1;
+                let _ = core.tick(now);
+                while let Some(frame) = out(&mut core, now) {
+                    if frame == STOP {
+                        stopped = Some(now);
+                    }
+                }
+            }
+        }
+        let stopped = stopped.expect("the failsafe never stopped the chassis");
+        assert!(
+            stopped <= heard + u64::from(Config::DEFAULT.failsafe_ms) + 2,
+            "stopped {} ms after the board was last heard",
+            stopped - heard
+        );
+        assert_eq!(core.failsafe_stops(), 1);
+    }
+
+    #[test]
     fn stop_cancels_an_outstanding_turn() {
         let mut core = idle_core();
         core.turn(Turn::by_deci_degrees(900), 10).unwrap();

@@ -681,6 +681,32 @@ mod tests {
     }
 
     #[test]
+    fn readbacks_a_silent_board_leaves_unanswered_never_hold_the_failsafe_off() {
+        // Heard at 10, then silent; a readback asked for again as soon as one gives up (another
+        // thread's loop): the forced stop still comes 300 ms after the last frame heard.
+        let mut core = driving(0);
+        hear(&mut core, &telemetry(), 10);
+        let mut stopped = None;
+        let mut now = 10;
+        while now < 2_000 && stopped.is_none() {
+            if !core.busy() {
+                core.start(Request::Read(Readback::Geometry)).unwrap();
+            }
+            now += 1;
+            core.tick(now);
+            if out(&mut core, now).contains(&FORCED_STOP.to_vec()) {
+                stopped = Some(now);
+            }
+        }
+        assert_eq!(
+            stopped,
+            Some(311),
+            "the forced stop 300 ms after the board was last heard"
+        );
+        assert_eq!(core.failsafe_stops(), 1);
+    }
+
+    #[test]
     fn telemetry_dropped_five_in_a_row_never_trips_the_failsafe() {
         // Frames every 45 ms; five dropped in a row leave a 270 ms gap.
         let mut core = driving(0);
