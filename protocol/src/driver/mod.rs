@@ -58,8 +58,9 @@
 //! (telemetry or reply) has been read for [`Config::failsafe_ms`] (100 ms; 200 ms with
 //! [`Config::HOST`]), or, after a settings frame, for [`Config::settings_pause_ms`] (600 ms:
 //! the board pauses telemetry while settings are made, A13) until its telemetry is back; a read
-//! counts as a settings frame once the board has answered it (reads a silent board leaves
-//! unanswered never hold the failsafe off, however often they are sent). It is
+//! counts as a settings frame once the board has answered it, and a read left unanswered ends
+//! the allowance (a paused board still answers reads: reads a silent board leaves unanswered
+//! never hold the failsafe off, however often they are sent). It is
 //! judged only after every byte the UART holds has been read, so a loop slower than the limit
 //! is never stopped by its own slowness; such a loop stops a silent board at its first poll
 //! that reads nothing.
@@ -226,7 +227,8 @@ pub struct Config {
     /// sends stop (100 ms; 200 ms with [`Config::HOST`]).
     pub failsafe_ms: u32,
     /// After a settings frame the board pauses its telemetry (A13: at least up to 500 ms); the
-    /// failsafe allows it this long to speak again (after a read, once the board answered it).
+    /// failsafe allows it this long to speak again (after a read, once the board answered it;
+    /// until a read goes unanswered).
     pub settings_pause_ms: u32,
     /// A line quiet for this long marks a frame boundary ([`crate::DownlinkParser::quiet`]). It
     /// must be longer than any gap *inside* a frame: 2 ms on a UART peripheral, more behind a

@@ -9,7 +9,8 @@
 //!   sees the start of one frame completed by another.
 //! * **The failsafe.** While the chassis is moving, no frame heard from the board for
 //!   `failsafe_ms` (or `settings_pause_ms` after a settings frame, until telemetry is back; a
-//!   read counts once the board has answered it) queues the wire format's stop
+//!   read counts once the board has answered it, and a read unanswered ends the allowance)
+//!   queues the wire format's stop
 //!   frame ([`Wire::stop`]), ahead of anything else not yet begun.
 //! * **Time** is the core's own monotonic milliseconds ([`Timebase`]): a `u32` tick counter that
 //!   wraps, or a clock that goes back, never stops the failsafe or hangs a wait.
@@ -243,6 +244,18 @@ impl<W: Wire> Safety<W> {
         let read = at_ms.saturating_sub(since_read);
         let since = self.settings_sent_ms.map_or(read, |t| t.max(read));
         self.settings_sent(since);
+    }
+
+    /// The last read went unanswered past its deadline: the board is not answering, so it is
+    /// not paused either (a paused board answers reads). The pause allowed for the frames sent
+    /// up to that read ends: silence counts from the last frame heard.
+    pub(crate) fn read_unanswered(&mut self) {
+        let now = self.now();
+        let since_read = u64::from((now as u32).wrapping_sub(self.read_sent_low));
+        let read = now.saturating_sub(since_read);
+        if self.settings_sent_ms.is_some_and(|t| t <= read) {
+            self.settings_sent_ms = None;
+        }
     }
 
     /// When the last frame of any kind was heard.

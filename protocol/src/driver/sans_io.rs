@@ -1246,6 +1246,8 @@ impl DriverCore {
                 let waited = u32::try_from(deadline_ms.saturating_sub(sent_ms)).unwrap_or(u32::MAX);
                 self.late_rtt_ms = self.late_rtt_ms.max(waited.saturating_mul(2));
                 self.unanswered(&read);
+                // A board that answers nothing is silent, not paused.
+                self.safety.read_unanswered();
                 match read.check {
                     Check::Once => self.finish(Err(CoreError::Timeout(read.register))),
                     Check::Agree | Check::Plausible => self.retry(read),
@@ -1706,6 +1708,39 @@ mod tests {
             stopped - heard
         );
         assert_eq!(core.failsafe_stops(), 1);
+    }
+
+    #[test]
+    fn a_read_unanswered_ends_the_pause_an_answered_read_allowed() {
+        // Moving, reads answered (each allows the board a telemetry pause, A13), then the board
+        // goes silent: the next read goes unanswered, and the stop comes failsafe_ms after the
+        // last frame heard, not settings_pause_ms after the last read answered.
+        let mut core = idle_core();
+        let mut now = 700;
+        core.velocity(Velocity::new(0, 100, 0), now).unwrap();
+        assert!(out(&mut core, now).is_some());
+        core.start(Request::Read(Register::MaxSpeed)).unwrap();
+        assert!(out(&mut core, now).is_some());
+        reply(&mut core, Register::MaxSpeed, 1_000, now + 1);
+        assert_eq!(core.take_outcome(), Some(Ok(Outcome::Value(1_000))));
+        let heard = now + 1;
+        now = core.now_ms();
+        core.start(Request::Read(Register::MotorVoltage)).unwrap();
+        assert!(out(&mut core, now).is_some());
+        let mut stopped = None;
+        while now < 2_000 && stopped.is_none() {
+            now += 1;
+            let _ = core.tick(now);
+            if out(&mut core, now).as_deref() == Some(&STOP[..]) {
+                stopped = Some(now);
+            }
+        }
+        let stopped = stopped.expect("the failsafe never stopped the chassis");
+        assert!(
+            stopped <= heard + u64::from(Config::DEFAULT.failsafe_ms) + 2,
+            "stopped {} ms after the board was last heard",
+            stopped - heard
+        );
     }
 
     #[test]

@@ -387,6 +387,8 @@ impl DriverCore {
         if let Some(mut job) = self.job {
             if let Phase::Waiting { deadline_ms } = job.phase {
                 if now > deadline_ms {
+                    // A board that answers nothing is silent, not paused.
+                    self.safety.read_unanswered();
                     if job.tries >= self.config.read_tries.max(1) {
                         self.finish(Err(CoreError::NoReadback(job.readback())));
                     } else {
@@ -704,6 +706,35 @@ mod tests {
             "the forced stop 300 ms after the board was last heard"
         );
         assert_eq!(core.failsafe_stops(), 1);
+    }
+
+    #[test]
+    fn a_readback_unanswered_ends_the_pause_an_answered_one_allowed() {
+        // Moving, a readback answered at 20 (it allows the board a telemetry pause, A13), then
+        // the board silent: the next readback goes unanswered, and the forced stop comes 300 ms
+        // after the reply, not settings_pause_ms after the readback.
+        let mut core = driving(0);
+        hear(&mut core, &telemetry(), 10);
+        core.start(Request::Read(Readback::Geometry)).unwrap();
+        assert_eq!(out(&mut core, 10).len(), 1);
+        let reply = Reply {
+            request: Readback::Geometry,
+            payload: [0; 10],
+        }
+        .encode();
+        assert!(hear(&mut core, &reply, 20).is_empty());
+        assert!(matches!(core.take_outcome(), Some(Ok(Outcome::Reply(_)))));
+        core.start(Request::Read(Readback::Geometry)).unwrap();
+        let mut stopped = None;
+        let mut now = 20;
+        while now < 2_000 && stopped.is_none() {
+            core.tick(now);
+            if out(&mut core, now).contains(&FORCED_STOP.to_vec()) {
+                stopped = Some(now);
+            }
+            now += 1;
+        }
+        assert_eq!(stopped, Some(321), "the forced stop 300 ms after the reply");
     }
 
     #[test]
