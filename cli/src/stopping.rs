@@ -113,12 +113,15 @@ pub fn stop<K: Spoken>(driver: &mut HostDriver<K>) -> Stopped {
 /// a moment ago: v1.0.0 sends a frame every 39-47 ms, the 2020 board every 10 ms).
 const FIRST_FRAME: std::time::Duration = std::time::Duration::from_millis(150);
 
-/// Waits up to [`FIRST_FRAME`] for the board's first frame when nothing has come from it yet,
-/// so that a stop right after the port opened is judged by what the board sends.
+/// Waits up to [`FIRST_FRAME`] for the board's first frame when none has come yet (nothing,
+/// or the tail of a frame the port opened in the middle of), so that a stop right after the
+/// port opened is judged by what the board sends.
 fn await_first_frame<K: Spoken>(driver: &mut HostDriver<K>) {
     let until = std::time::Instant::now() + FIRST_FRAME;
-    while driver.core().heard_at(driver.uart().now_ms()) == Heard::Nothing
-        && std::time::Instant::now() < until
+    while matches!(
+        driver.core().heard_at(driver.uart().now_ms()),
+        Heard::Nothing | Heard::NoFrame
+    ) && std::time::Instant::now() < until
     {
         if driver.poll().is_err() {
             return;
