@@ -99,7 +99,7 @@ impl Link for Checker {
         self.last_stop = Some(crate::check::StopRecord {
             result,
             sent: driver.uart().stops_sent() > before,
-            unheard: crate::stopping::unheard(driver),
+            unheard: crate::stopping::unheard_after_stop(driver),
         });
         result
     }

@@ -95,7 +95,7 @@ impl LinkV1 for CheckerV1 {
         self.last_stop = Some(crate::check::StopRecord {
             result,
             sent: driver.uart().stops_sent() > before,
-            unheard: crate::stopping::unheard(driver),
+            unheard: crate::stopping::unheard_after_stop(driver),
         });
         result
     }

@@ -9,10 +9,10 @@
 //! - **The session gone**, for the commands that last ([`Kind::Lasting`]: they move or watch
 //!   the chassis for a while): the terminal the command runs on hung up (a closed window, a
 //!   dropped ssh session, a killed tmux server; no SIGHUP need come: the command is not always
-//!   the session's leader), or its standard input, a pipe open when it started, ended
-//!   (`ssh host chassis …` without a terminal, whose connection dropped). Standard input that
-//!   is a file or `/dev/null` (a script, a systemd service), or a pipe already at its end when
-//!   the command started (cron), never ends a command.
+//!   the session's leader), or its standard input, a pipe, ended (`ssh host chassis …` without
+//!   a terminal, whose connection dropped), also one already at its end when the command
+//!   started: nobody is there to stop it. Standard input that is a file or `/dev/null` (a
+//!   script, a systemd service: `</dev/null` in a crontab) never ends a command.
 //!
 //! A command that moves or watches the chassis checks [`ended`] in its loop (the port's waits
 //! check it too: [`crate::port::Port`]), stops the chassis (cancelling a turn), says what
@@ -78,10 +78,8 @@ struct Caught {
     default: Arc<AtomicBool>,
     /// The session's end, once seen (it is not looked for again).
     session: Mutex<Option<Ending>>,
-    /// The terminal watched for its end (and standard input, if [`Caught::input`]).
+    /// The terminal and standard input watched for their end.
     watched: AtomicBool,
-    /// Standard input is watched for its end.
-    input: AtomicBool,
 }
 
 /// What a command does, for its endings.
@@ -108,7 +106,6 @@ pub fn catch_from_start() {
         default: Arc::new(AtomicBool::new(false)),
         session: Mutex::new(None),
         watched: AtomicBool::new(false),
-        input: AtomicBool::new(false),
     });
     for (signal, name) in SIGNALS {
         if inherited_ignored(signal) && Some(signal) == hangup() {
@@ -170,12 +167,7 @@ pub fn for_command(kind: Kind) {
             }
         }
         Kind::Brief => {}
-        Kind::Lasting => {
-            // An input already at its end (cron's, `input=b""`) is no session to watch.
-            let input_open = !matches!(session_gone(true), Some(Ending::InputEnded));
-            caught.input.store(input_open, Ordering::SeqCst);
-            caught.watched.store(true, Ordering::SeqCst);
-        }
+        Kind::Lasting => caught.watched.store(true, Ordering::SeqCst),
     }
 }
 
@@ -201,15 +193,15 @@ pub fn ended() -> Option<Ending> {
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner);
     if session.is_none() {
-        *session = session_gone(caught.input.load(Ordering::SeqCst));
+        *session = session_gone();
     }
     *session
 }
 
-/// The terminal hung up, or (`input`) standard input ended: looked for without reading
+/// The terminal hung up, or standard input (a pipe) ended: looked for without reading
 /// anything, by `poll(2)` on the three standard streams.
 #[cfg(unix)]
-fn session_gone(input: bool) -> Option<Ending> {
+fn session_gone() -> Option<Ending> {
     use rustix::event::{PollFd, PollFlags, poll};
     use std::io::IsTerminal;
     use std::os::fd::AsFd;
@@ -238,11 +230,11 @@ fn session_gone(input: bool) -> Option<Ending> {
         // A terminal that hung up may no longer say it is one.
         return Some(Ending::TerminalClosed);
     }
-    (input && hung(0)).then_some(Ending::InputEnded)
+    hung(0).then_some(Ending::InputEnded)
 }
 
 #[cfg(not(unix))]
-fn session_gone(_input: bool) -> Option<Ending> {
+fn session_gone() -> Option<Ending> {
     None
 }
 

@@ -332,10 +332,23 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err((message, code)) => {
-            tell!("chassis: {message}");
+            last_words(format!("chassis: {message}\n"));
             ExitCode::from(code)
         }
     }
+}
+
+/// Writes `line` on stderr, waiting at most half a second: a terminal that takes no output (a
+/// stalled ssh link) does not keep a command that has stopped the chassis from ending.
+fn last_words(line: String) {
+    let (done, wait) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut err = std::io::stderr();
+        let _ = err.write_all(line.as_bytes());
+        let _ = err.flush();
+        let _ = done.send(());
+    });
+    let _ = wait.recv_timeout(std::time::Duration::from_millis(500));
 }
 
 /// The global options that only some commands take: refused where they mean nothing, and

@@ -12,6 +12,7 @@
 //! goes quiet is stopped, and stays stopped until the link is back and a key is pressed again;
 //! the figures of a board gone quiet are marked stale.
 
+mod terminal;
 pub mod v1;
 
 use crate::device::{explain, open};
@@ -21,7 +22,7 @@ use crate::stopping;
 use chassis_protocol::driver::{CoreError, Error, Event as DriverEvent};
 use chassis_protocol::{Battery, Downlink, Encoders, Imu, Lock, Stream, Velocity};
 use ratatui::Frame;
-use ratatui::crossterm::event::{self, Event, KeyCode, KeyEventKind, KeyModifiers};
+use ratatui::crossterm::event::{Event, KeyCode, KeyEventKind, KeyModifiers};
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::{Line, Span};
@@ -395,16 +396,16 @@ impl<C: Chassis> Monitor<C> {
 
 /// `chassis monitor [--drive]` over the board `open` opens (once the terminal is known to be
 /// one): draws until a quit key or an ending ([`crate::ending`]: a signal, the terminal gone),
-/// then stops the chassis before giving the terminal back.
-///
-/// The keys are read on a thread of their own: the loop that owns the driver never waits on
-/// the terminal, so a terminal that hangs up (whose reads then never block again) cannot keep
-/// it from stopping the chassis and ending.
+/// then stops the chassis before giving the terminal back. The terminal is read and drawn on
+/// threads of their own ([`terminal`]): nothing it does keeps this loop from the driver.
 pub fn run_monitor<C: Chassis>(
     open: impl FnOnce() -> Result<C, String>,
     drive: bool,
     speed: i32,
-) -> Result<(), String> {
+) -> Result<(), String>
+where
+    C::View: Send + 'static,
+{
     use std::io::IsTerminal;
     if !std::io::stdin().is_terminal() || !std::io::stdout().is_terminal() {
         return Err(
@@ -413,12 +414,15 @@ pub fn run_monitor<C: Chassis>(
     }
     let mut monitor = Monitor::new(open()?, drive, speed);
     crate::device::before_motion()?;
-    let mut terminal = ratatui::try_init().map_err(|e| format!("terminal: {e}"))?;
-    let keys = read_keys();
-    let result = monitor_loop(&mut terminal, &mut monitor, &keys);
+    let screen = terminal::Screen::start(
+        ratatui::try_init().map_err(|e| format!("terminal: {e}"))?,
+        C::render,
+    );
+    let keys = terminal::Keys::start();
+    let result = monitor_loop(&mut monitor, &keys, &screen);
     // Stop before giving the terminal back, whatever happened.
     let stopped = monitor.stop_on_exit();
-    give_back(terminal);
+    screen.give_back();
     if let Some(end) = ending::ended() {
         return Err(format!(
             "{}{}",
@@ -436,61 +440,30 @@ pub fn run_monitor<C: Chassis>(
     }
 }
 
-/// Gives the terminal back as it was (raw mode off, the main screen, the cursor shown). A
-/// terminal that hung up takes none of it, and nothing is said of that (ratatui's own restore
-/// would print, and printing to a terminal gone panics).
-fn give_back(mut terminal: ratatui::DefaultTerminal) {
-    let _ = ratatui::try_restore();
-    if terminal.show_cursor().is_err() {
-        // Its drop would try again and print the failure.
-        std::mem::forget(terminal);
-    }
-}
-
-/// The terminal's events, read on a thread of its own: an error reading them is the last one
-/// sent.
-fn read_keys() -> std::sync::mpsc::Receiver<Result<Event, String>> {
-    let (send, keys) = std::sync::mpsc::channel();
-    std::thread::spawn(move || {
-        loop {
-            let event = event::read().map_err(|e| format!("terminal: {e}"));
-            let failed = event.is_err();
-            if send.send(event).is_err() || failed {
-                return;
-            }
-        }
-    });
-    keys
-}
-
 fn monitor_loop<C: Chassis>(
-    terminal: &mut ratatui::DefaultTerminal,
     monitor: &mut Monitor<C>,
-    keys: &std::sync::mpsc::Receiver<Result<Event, String>>,
-) -> Result<(), String> {
+    keys: &terminal::Keys,
+    screen: &terminal::Screen<C::View>,
+) -> Result<(), String>
+where
+    C::View: Send + 'static,
+{
     let mut next_draw = Instant::now();
     while ending::ended().is_none() {
         monitor.tick(20);
-        loop {
-            let event = match keys.try_recv() {
-                Ok(event) => event?,
-                Err(std::sync::mpsc::TryRecvError::Empty) => break,
-                Err(std::sync::mpsc::TryRecvError::Disconnected) => {
-                    return Err("terminal: its keys can no longer be read".into());
-                }
-            };
+        while let Some(event) = keys.next()? {
             if let Some(key) = Key::of(&event) {
                 if !monitor.key(key) {
                     return Ok(());
                 }
             }
         }
+        if let Some(e) = screen.failed() {
+            return Err(e);
+        }
         if Instant::now() >= next_draw {
             next_draw = Instant::now() + Duration::from_millis(100);
-            let view = monitor.view();
-            terminal
-                .draw(|f| C::render(f, &view))
-                .map_err(|e| format!("terminal: {e}"))?;
+            screen.show(monitor.view());
         }
     }
     Ok(())

@@ -102,11 +102,39 @@ pub fn stop<K: Spoken>(driver: &mut HostDriver<K>) -> Stopped {
         Ok(()) if driver.core().turn_unsettled() => {
             Stopped::Unconfirmed(pending_turn(driver).trim_start_matches("; ").into())
         }
-        Ok(()) => match unheard(driver) {
+        Ok(()) => match unheard_after_stop(driver) {
             None => Stopped::Confirmed,
             Some(why) => Stopped::Unconfirmed(why),
         },
     }
+}
+
+/// How long a stop waits for the board's first frame when none has come yet (a driver opened
+/// a moment ago: v1.0.0 sends a frame every 39-47 ms, the 2020 board every 10 ms).
+const FIRST_FRAME: std::time::Duration = std::time::Duration::from_millis(150);
+
+/// Waits up to [`FIRST_FRAME`] for the board's first frame when none has come yet (nothing,
+/// or the tail of a frame the port opened in the middle of), so that a stop right after the
+/// port opened is judged by what the board sends.
+fn await_first_frame<K: Spoken>(driver: &mut HostDriver<K>) {
+    let until = std::time::Instant::now() + FIRST_FRAME;
+    while matches!(
+        driver.core().heard_at(driver.uart().now_ms()),
+        Heard::Nothing | Heard::NoFrame
+    ) && std::time::Instant::now() < until
+    {
+        if driver.poll().is_err() {
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+}
+
+/// After a stop went out: why the board is not known to have heard it (`None`: its frames
+/// are arriving), waiting up to [`FIRST_FRAME`] for the first one when none came yet.
+pub fn unheard_after_stop<K: Spoken>(driver: &mut HostDriver<K>) -> Option<String> {
+    await_first_frame(driver);
+    unheard(driver)
 }
 
 /// Why the board is not known to have heard: `None` when its frames are arriving.

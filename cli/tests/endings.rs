@@ -39,6 +39,46 @@ fn a_closed_terminal_ends_a_watching_monitor() {
     assert!(heard.is_empty(), "a watching monitor sent {heard:02X?}");
 }
 
+#[test]
+fn a_terminal_that_takes_no_output_keeps_neither_the_failsafe_nor_a_signal_from_the_chassis() {
+    let board = TestBoard::start();
+    // A large terminal: its screen changes by some 12 KB a second, and a pseudo-terminal takes
+    // about 17 KB that nobody reads.
+    let args = ["--port", board.path.as_str(), "monitor", "--drive"];
+    let mut term = harness::Terminal::spawn_sized(&args, 400, 150);
+    term.wait_for_text("LINK UP");
+    term.press(b"w");
+    board.wait_for("the key's velocity", harness::forward(300));
+    // Nobody reads the screen any more: the monitor's writes to it soon block.
+    term.stop_reading();
+    std::thread::sleep(Duration::from_millis(3_000));
+    let sent = board.heard().len();
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(
+        board.heard().len() > sent,
+        "the monitor kept driving (re-sent the velocity)"
+    );
+    // The board goes quiet: the failsafe stops the chassis all the same.
+    board.go_silent(true);
+    std::thread::sleep(Duration::from_millis(600));
+    let heard = board.heard();
+    let last_stop = heard
+        .windows(harness::STOP.len())
+        .rposition(|w| w == harness::STOP)
+        .expect("the failsafe's stop");
+    assert!(
+        last_stop >= sent,
+        "the stop came after the terminal stalled"
+    );
+    board.go_silent(false);
+    harness::signal(&term.child, "INT");
+    let (status, took) = ends_within(&mut term, 5);
+    assert_eq!(status.code(), Some(130), "{status:?}");
+    assert!(took < Duration::from_secs(2), "ended after {took:?}");
+    let (board, heard) = board.finish();
+    assert_stopped(&board, &heard);
+}
+
 /// `chassis args` on this board's port, started with SIGINT ignored, as a script's background
 /// job starts it (`cmd &` in a script ignores SIGINT).
 fn spawn_ignoring_sigint(path: &str, args: &[&str]) -> std::process::Child {

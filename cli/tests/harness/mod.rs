@@ -40,6 +40,8 @@ pub fn pty_pair() -> (TTYPort, TTYPort) {
 struct Tap {
     inner: TTYPort,
     heard: Arc<Mutex<Vec<u8>>>,
+    /// When each read ended, and how many bytes had been heard by then.
+    times: Arc<Mutex<Vec<(Instant, usize)>>>,
     silent: Arc<AtomicBool>,
     drop_replies: Arc<AtomicU32>,
 }
@@ -47,7 +49,14 @@ struct Tap {
 impl Read for Tap {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
         let n = self.inner.read(buf)?;
-        self.heard.lock().unwrap().extend_from_slice(&buf[..n]);
+        let mut heard = self.heard.lock().unwrap();
+        heard.extend_from_slice(&buf[..n]);
+        if n > 0 {
+            self.times
+                .lock()
+                .unwrap()
+                .push((Instant::now(), heard.len()));
+        }
         Ok(n)
     }
 }
@@ -85,6 +94,7 @@ pub struct TestBoard<B = Board> {
     silent: Arc<AtomicBool>,
     drop_replies: Arc<AtomicU32>,
     heard: Arc<Mutex<Vec<u8>>>,
+    times: Arc<Mutex<Vec<(Instant, usize)>>>,
     thread: Option<JoinHandle<io::Result<B>>>,
     _keep: TTYPort,
 }
@@ -113,9 +123,11 @@ impl<B: Simulated + Send + 'static> TestBoard<B> {
         let silent = Arc::new(AtomicBool::new(false));
         let drop_replies = Arc::new(AtomicU32::new(0));
         let heard = Arc::new(Mutex::new(Vec::new()));
+        let times = Arc::new(Mutex::new(Vec::new()));
         let tap = Tap {
             inner: board_end,
             heard: Arc::clone(&heard),
+            times: Arc::clone(&times),
             silent: Arc::clone(&silent),
             drop_replies: Arc::clone(&drop_replies),
         };
@@ -127,6 +139,7 @@ impl<B: Simulated + Send + 'static> TestBoard<B> {
             silent,
             drop_replies,
             heard,
+            times,
             thread: Some(thread),
             _keep: path_end,
         }
@@ -145,6 +158,16 @@ impl<B: Simulated + Send + 'static> TestBoard<B> {
     /// Every byte the board was sent so far.
     pub fn heard(&self) -> Vec<u8> {
         self.heard.lock().unwrap().clone()
+    }
+
+    /// When the board had heard its first `len` bytes (`None`: not yet).
+    pub fn heard_by(&self, len: usize) -> Option<Instant> {
+        self.times
+            .lock()
+            .unwrap()
+            .iter()
+            .find(|(_, total)| *total >= len)
+            .map(|(at, _)| *at)
     }
 
     /// `chassis --port PATH args`, run to its end.
@@ -299,6 +322,11 @@ pub struct Terminal {
     /// The command.
     pub child: Child,
     master: Option<TTYPort>,
+    /// The terminal's other end, held so that what the command wrote last stays readable after
+    /// it exits (a terminal whose every other end is closed throws it away).
+    slave: Option<TTYPort>,
+    /// Columns and rows.
+    size: (u16, u16),
     screen: Arc<Mutex<Vec<u8>>>,
     reader: Option<JoinHandle<()>>,
     done: Arc<AtomicBool>,
@@ -307,6 +335,11 @@ pub struct Terminal {
 impl Terminal {
     /// Starts `chassis args` with its stdin, stdout and stderr on a new terminal.
     pub fn spawn(args: &[&str]) -> Terminal {
+        Terminal::spawn_sized(args, 100, 30)
+    }
+
+    /// [`Terminal::spawn`] on a terminal of `cols` × `rows`.
+    pub fn spawn_sized(args: &[&str], cols: u16, rows: u16) -> Terminal {
         let (master, slave) = pty_pair();
         let path = slave.name().unwrap();
         let open = || {
@@ -317,7 +350,7 @@ impl Terminal {
                 .unwrap()
         };
         let ok = Process::new("stty")
-            .args(["cols", "100", "rows", "30"])
+            .args(["cols", &cols.to_string(), "rows", &rows.to_string()])
             .stdin(open())
             .status()
             .unwrap()
@@ -330,7 +363,6 @@ impl Terminal {
             .stderr(open())
             .spawn()
             .unwrap();
-        drop(slave);
         let screen = Arc::new(Mutex::new(Vec::new()));
         let done = Arc::new(AtomicBool::new(false));
         let mut reading = master.try_clone_native().unwrap();
@@ -350,6 +382,8 @@ impl Terminal {
         Terminal {
             child,
             master: Some(master),
+            slave: Some(slave),
+            size: (cols, rows),
             screen,
             reader: Some(reader),
             done,
@@ -358,7 +392,7 @@ impl Terminal {
 
     /// The screen as it stands (a terminal emulator replays everything drawn).
     pub fn text(&self) -> String {
-        let mut parser = vt100::Parser::new(30, 100, 0);
+        let mut parser = vt100::Parser::new(self.size.1, self.size.0, 0);
         parser.process(&self.screen.lock().unwrap());
         parser.screen().contents()
     }
@@ -391,6 +425,15 @@ impl Terminal {
         master.flush().unwrap();
     }
 
+    /// Stops reading what the command writes, the terminal left open: once its buffer is full,
+    /// the command's writes to it block (a stalled ssh link, a terminal paused).
+    pub fn stop_reading(&mut self) {
+        self.done.store(true, Ordering::SeqCst);
+        if let Some(r) = self.reader.take() {
+            let _ = r.join();
+        }
+    }
+
     /// Closes the terminal under the command, as a terminal window closed or an ssh session
     /// dropped does (the command is not the session's leader: no SIGHUP comes from the
     /// kernel; its terminal hangs up, reads end and writes fail).
@@ -400,6 +443,7 @@ impl Terminal {
             let _ = r.join();
         }
         self.master = None;
+        self.slave = None;
     }
 
     /// Waits (up to `secs`) for the command to end: its exit status.
