@@ -30,7 +30,10 @@
 //! `sim`) behind an in-memory UART, on simulated time:
 //!
 //! ```
-//! # #[cfg(all(feature = "driver", feature = "sim"))] {
+//! # #[cfg(not(all(feature = "driver", feature = "sim")))]
+//! # fn main() {}
+//! # #[cfg(all(feature = "driver", feature = "sim"))]
+//! # fn main() -> Result<(), chassis_protocol::driver::Error<core::convert::Infallible>> {
 //! use chassis_protocol::driver::{Config, blocking::Driver, reg};
 //! use chassis_protocol::sim::{Board, SimClock, SimConfig, SimUart};
 //! use chassis_protocol::Velocity;
@@ -43,8 +46,8 @@
 //! assert_eq!(volts, 1_200);
 //! driver.turn_by(900)?;                               // 90°, sent once: a second is refused
 //! driver.stop()?;                                     // stops, and cancels the turn
+//! # Ok(())
 //! # }
-//! # Ok::<(), chassis_protocol::driver::Error<core::convert::Infallible>>(())
 //! ```
 //!
 //! On a PC or a Raspberry Pi (feature `std`), the same driver over a serial port:

@@ -16,7 +16,7 @@
 //! | `qemu ELF [--scenario NAME]` | boots a firmware in QEMU against the simulated chassis (the QEMU board's cargo runner) |
 //!
 //! Each task installs what it needs (rustup targets, `qemu-system-arm` through apt when run as
-//! root, defmt-print, the nightly toolchain, cargo-fuzz and cargo-public-api) before it runs, so
+//! root, defmt-print, the nightly toolchain, cargo-fuzz, cargo-public-api and cargo-hack) before it runs, so
 //! a fresh machine with rustup and cargo needs nothing else.
 
 mod firmware;
@@ -397,11 +397,7 @@ fn test() -> Result<(), String> {
     // chassis-host-tests --test properties` (a new random seed each run).
     let seeded = [("PROPTEST_RNG_SEED", PROPTEST_SEED)];
     run_with(&cargo_program(), &["test", "--workspace"], &seeded)?;
-    run_with(
-        &cargo_program(),
-        &["test", "-p", "chassis-protocol", "--all-features"],
-        &seeded,
-    )?;
+    crates_alone(&seeded)?;
     for target in THUMB_TARGETS {
         for features in ["", "defmt,serde", "driver,nb,async,sim,defmt,serde"] {
             let build = [
@@ -706,6 +702,47 @@ fn current_public_api() -> Result<String, String> {
         api.push('\n');
     }
     Ok(api)
+}
+
+/// cargo-hack's version, pinned.
+const CARGO_HACK: &str = "0.6.46";
+
+/// Each published crate tests green on its own, as someone who downloaded it tests it: with
+/// its default features, with none, with every feature alone and (where they go together) with
+/// all, without the feature unification of the workspace (cargo-hack `--each-feature`). The
+/// CLI's integration tests drive its binary and ran with the workspace; alone, it is built
+/// and its unit tests run.
+fn crates_alone(env: &[(&str, &str)]) -> Result<(), String> {
+    install_cargo_hack()?;
+    let hack = ["hack", "test", "--each-feature"];
+    for krate in ["chassis-protocol", "chassis-capture"] {
+        run_with(&cargo_program(), &[&hack[..], &["-p", krate]].concat(), env)?;
+    }
+    // A board picks `blocking` or `async`: the two together do not build.
+    let bringup = ["--exclude-all-features", "-p", "chassis-bringup"];
+    run_with(&cargo_program(), &[&hack[..], &bringup].concat(), env)?;
+    run_with(
+        &cargo_program(),
+        &[&hack[..], &["-p", "chassis-cli", "--bins"]].concat(),
+        env,
+    )
+}
+
+/// Installs cargo-hack ([`CARGO_HACK`]) unless that version is there.
+fn install_cargo_hack() -> Result<(), String> {
+    let present = Command::new("cargo")
+        .args(["hack", "--version"])
+        .output()
+        .is_ok_and(|o| {
+            o.status.success()
+                && String::from_utf8_lossy(&o.stdout)
+                    .split_whitespace()
+                    .any(|word| word == CARGO_HACK)
+        });
+    if present {
+        return Ok(());
+    }
+    cargo(&["install", "--locked", "cargo-hack", "--version", CARGO_HACK])
 }
 
 /// Installs cargo-public-api ([`CARGO_PUBLIC_API`]) unless that version is there.
