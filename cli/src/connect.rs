@@ -7,6 +7,18 @@ use chassis_protocol::detect::{self, Detection, Firmware, Heard};
 use chassis_protocol::driver::Config;
 use chassis_protocol::driver::host::MonotonicClock;
 
+/// The generation a silent line is taken as when the command's arguments do not say, and the
+/// one `chassis sim` serves unless told.
+pub const DEFAULT_FIRMWARE: Firmware = Firmware::V2020;
+
+/// Whether `name` names a setting of the v1.0.0 firmware only (a readback or one of its
+/// fields, and no 2020 register).
+pub fn only_v1_name(name: &str) -> bool {
+    let v1 = chassis_protocol::v1::Readback::from_name(name).is_some()
+        || chassis_protocol::v1::FIELDS.iter().any(|(n, _)| *n == name);
+    v1 && chassis_protocol::Register::from_name(name).is_none()
+}
+
 /// `--firmware`: exactly `2020`, `v1.0.0` or `v1`.
 pub fn firmware_arg(name: &str) -> Result<Firmware, String> {
     match name {
@@ -97,15 +109,9 @@ pub fn detect_command(path: &str) -> Result<(), (String, u8)> {
     Ok(())
 }
 
-/// The firmware a command talks to: `given`, or found on `path`. A line that stays silent is
-/// taken as the 2020 firmware (the command's own error then says what did not answer); bytes of
-/// neither generation are an error.
-pub fn generation(path: &str, given: Option<Firmware>) -> Result<Firmware, String> {
-    generation_or(path, given, Firmware::V2020)
-}
-
-/// [`generation`] for `chassis check`: bytes of neither generation fail its link check (exit
-/// status 10, as the firmware's bring-up does), with nothing sent.
+/// The firmware `chassis check` talks to: `given`, or found on `path` (a silent line: the
+/// [`DEFAULT_FIRMWARE`]); bytes of neither generation fail its link check (exit status 10, as
+/// the firmware's bring-up does), with nothing sent.
 pub fn generation_for_check(path: &str, given: Option<Firmware>) -> Result<Firmware, (String, u8)> {
     if let Some(firmware) = given {
         return Ok(firmware);
@@ -113,7 +119,7 @@ pub fn generation_for_check(path: &str, given: Option<Firmware>) -> Result<Firmw
     let found = listen(path).map_err(|e| (e, 1))?;
     match found.firmware {
         Some(firmware) => Ok(firmware),
-        None if found.heard.bytes == 0 => Ok(Firmware::V2020),
+        None if found.heard.bytes == 0 => Ok(DEFAULT_FIRMWARE),
         None => Err((
             format!(
                 "FAIL: link: {}; nothing was sent (--firmware 2020|v1.0.0 skips this check)",
@@ -127,9 +133,10 @@ pub fn generation_for_check(path: &str, given: Option<Firmware>) -> Result<Firmw
 /// The exit status of `chassis check` when its link check fails.
 const LINK_CHECK_FAILED: u8 = 10;
 
-/// [`generation`], a silent line taken as `silent`: the generation the command's own arguments
-/// belong to (`drive --vy`, `get geometry`: v1.0.0), so that its error says that nothing
-/// answered rather than that the arguments are the other firmware's.
+/// The firmware a command talks to: `given`, or found on `path` (it listens first, and only on
+/// a quiet line sends its two harmless probes). A line that stays silent is taken as `silent`,
+/// the generation the command's own arguments belong to, so that its error says that nothing
+/// answered; bytes of neither generation are an error.
 pub fn generation_or(
     path: &str,
     given: Option<Firmware>,

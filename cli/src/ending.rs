@@ -245,3 +245,14 @@ pub fn name(signal: i32) -> &'static str {
         .find(|(s, _)| *s == signal)
         .map_or("a signal", |(_, n)| n)
 }
+
+/// `Err` when the command must end before anything that moves the chassis is sent: nothing was.
+pub fn before_motion() -> Result<(), String> {
+    match ended() {
+        Some(end) => Err(format!(
+            "{}: the chassis was not moved (nothing that moves it was sent)",
+            end.words()
+        )),
+        None => Ok(()),
+    }
+}

@@ -32,11 +32,11 @@ macro_rules! tell_partial {
 }
 
 mod check;
-mod check_v1;
 mod connect;
-mod device;
+mod decode;
 mod encode;
 mod ending;
+mod generation;
 mod input;
 mod monitor;
 mod names;
@@ -45,13 +45,12 @@ mod port;
 mod record;
 mod sim;
 mod stopping;
-mod v1cmd;
+mod v1;
+mod v2020;
 mod value;
 
-use chassis_capture as decode;
 use chassis_protocol::detect::Firmware;
 use clap::{Parser, Subcommand};
-use names::RegisterName;
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -78,37 +77,7 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Cmd {
     /// Decode a capture: one JSON object per frame per line, a summary on stderr.
-    Decode {
-        /// The capture file ("-" or nothing: standard input).
-        file: Option<String>,
-        /// The master → board direction.
-        #[arg(long)]
-        uplink: bool,
-        /// The master → board side of the same capture (both sides time-stamped: --input
-        /// saleae-csv). Its reads tell the board side's parser which reply is awaited, as the
-        /// driver does; the frames of both sides come out in time order, each with "from".
-        #[arg(long, value_name = "FILE", conflicts_with = "uplink")]
-        master: Option<String>,
-        /// Both sides in one Saleae Logic 2 export: the rows of the analyser named NAME are
-        /// the master → board side, the others the board's (as --master FILE).
-        #[arg(
-            long,
-            value_name = "NAME",
-            conflicts_with_all = ["uplink", "master"]
-        )]
-        master_analyzer: Option<String>,
-        /// How the capture is written.
-        #[arg(long, value_enum, default_value = "raw")]
-        input: decode::Input,
-        /// How frames are written.
-        #[arg(long, value_enum, default_value = "json")]
-        format: decode::Format,
-        /// A gap in the time stamps longer than MS is a quiet line (a logic analyser's capture:
-        /// 2; a `chassis record` capture, stamped when the host read the bytes: 40, as the host
-        /// driver judges).
-        #[arg(long, value_name = "MS", default_value = "2")]
-        quiet_ms: f64,
-    },
+    Decode(decode::DecodeArgs),
     /// Print a master → board frame's bytes as hex.
     Encode {
         #[command(subcommand)]
@@ -127,20 +96,7 @@ enum Cmd {
     },
     /// Write a register and read it back (battery-range: FULL CUTOFF, 0.01 V each; v1.0.0: a
     /// settings field, e.g. wheel-diameter, written with the rest of its frame as read).
-    Set {
-        /// The register.
-        register: String,
-        /// The value (decimal or 0x hex).
-        #[arg(allow_hyphen_values = true)]
-        value: String,
-        /// battery-range only: the cut-off voltage.
-        #[arg(allow_hyphen_values = true)]
-        cutoff: Option<String>,
-        /// Go ahead with a write that starts a 30 s gyro calibration (gyro-calibration 0xFFFF,
-        /// system-mode switching bit 3 on).
-        #[arg(long)]
-        yes: bool,
-    },
+    Set(generation::SetArgs),
     /// Every register as JSON; or save them to a file, or restore them from one.
     Settings {
         /// Write the settings to FILE.
@@ -158,22 +114,7 @@ enum Cmd {
     Stop,
     /// Drive at a velocity for a while, then stop (Ctrl-C stops at once). 2020: --x --y --z
     /// (the board's raw units); v1.0.0: --vx --vy (m/s) --wz (rad/s).
-    Drive {
-        #[command(flatten)]
-        axes: encode::Axes,
-        /// v1.0.0: sideways velocity, m/s.
-        #[arg(long, value_name = "M/S", allow_hyphen_values = true)]
-        vx: Option<f64>,
-        /// v1.0.0: forward velocity, m/s.
-        #[arg(long, value_name = "M/S", allow_hyphen_values = true)]
-        vy: Option<f64>,
-        /// v1.0.0: rotation, rad/s (counter-clockwise positive).
-        #[arg(long, value_name = "RAD/S", allow_hyphen_values = true)]
-        wz: Option<f64>,
-        /// How long, in seconds.
-        #[arg(long = "for", value_name = "SECONDS", allow_hyphen_values = true)]
-        seconds: f64,
-    },
+    Drive(generation::DriveArgs),
     /// Turn by DEGREES (sent once: the board adds turns up) and wait until it is done (Ctrl-C
     /// cancels the turn).
     Turn {
@@ -196,18 +137,7 @@ enum Cmd {
     /// register, drive type, forward, sideways, a 90° turn, stop, battery, a control loop; on
     /// v1.0.0: the velocity followed, a rotation at a rate, the forced stop, settings only read).
     /// Exit status 0 when every check passes, else the failed check's code (10..=18).
-    Check {
-        /// Only what neither moves the chassis nor writes to the board: link, registers,
-        /// battery.
-        #[arg(long)]
-        no_motion: bool,
-        /// Do not ask before the chassis moves.
-        #[arg(long)]
-        yes: bool,
-        /// Set this drive type on the board (the board's own is kept if not given; 2020 only).
-        #[arg(long, value_enum, value_name = "TYPE", conflicts_with = "no_motion")]
-        drive_type: Option<DriveTypeName>,
-    },
+    Check(generation::CheckArgs),
     /// Capture what the board sends, time-stamped, into a file `chassis decode --input
     /// saleae-csv --quiet-ms 40` reads back (sends nothing; Ctrl-C ends it, the file complete).
     Record {
@@ -235,32 +165,25 @@ enum Cmd {
     },
 }
 
-/// A drive type, by name.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-enum DriveTypeName {
-    /// 0: omni wheels.
-    Omni,
-    /// 1: mecanum wheels.
-    Mecanum,
-    /// 2: differential, with encoders.
-    Differential,
-    /// 3: differential, without encoders (duty cycles).
-    DifferentialOpenLoop,
-}
-
-impl DriveTypeName {
-    const fn drive_type(self) -> chassis_protocol::DriveType {
-        use chassis_protocol::DriveType;
-        match self {
-            DriveTypeName::Omni => DriveType::Omni,
-            DriveTypeName::Mecanum => DriveType::Mecanum,
-            DriveTypeName::Differential => DriveType::Differential,
-            DriveTypeName::DifferentialOpenLoop => DriveType::DifferentialOpenLoop,
+impl Cmd {
+    /// The generation a silent line is taken as: the one the command's own arguments belong to
+    /// (`drive --vy`, `get geometry`: v1.0.0), so that its error says that nothing answered
+    /// rather than that the arguments are the other firmware's.
+    fn belongs_to(&self) -> Firmware {
+        let v1 = match self {
+            Cmd::Drive(drive) => drive.si(),
+            Cmd::Get { register } | Cmd::Set(generation::SetArgs { register, .. }) => {
+                connect::only_v1_name(register)
+            }
+            _ => false,
+        };
+        if v1 {
+            Firmware::V1_0_0
+        } else {
+            connect::DEFAULT_FIRMWARE
         }
     }
-}
 
-impl Cmd {
     /// What the command is, for the ways it can end early.
     const fn kind(&self) -> ending::Kind {
         match self {
@@ -286,41 +209,7 @@ fn main() -> ExitCode {
     ending::catch_from_start();
     let cli = Cli::parse();
     ending::for_command(cli.command.kind());
-    let result = options(&cli).and_then(|()| match cli.command {
-        Cmd::Check {
-            no_motion,
-            yes,
-            drive_type,
-        } => port(cli.port.as_deref())
-            .map_err(|e| (e, 1))
-            .and_then(|path| {
-                if connect::generation_for_check(path, cli.firmware)? == Firmware::V1_0_0
-                {
-                    if drive_type.is_some() {
-                        return Err((
-                            not_on_v1(
-                                "check --drive-type",
-                                "it has no drive-type register (each velocity frame carries the vendor's type byte): run `chassis check` without it",
-                            ),
-                            1,
-                        ));
-                    }
-                    return check_v1::check(path, no_motion, yes);
-                }
-                check::check(
-                    path,
-                    no_motion,
-                    yes,
-                    drive_type.map(DriveTypeName::drive_type),
-                )
-            }),
-        Cmd::Detect => port(cli.port.as_deref())
-            .map_err(|e| (e, 1))
-            .and_then(connect::detect_command),
-        // A signal the command caught (and stopped the chassis for): 128 + its number, as a
-        // shell reports a process the signal ended.
-        _ => run(cli).map_err(|e| (e, ending::ended().map_or(1, ending::Ending::exit_status))),
-    });
+    let result = options(&cli).and_then(|()| run(&cli));
     // A `--record` file never attached to a port is thrown away (what was there stays); one
     // that could not be written fails the command.
     port::discard_unused_recording();
@@ -335,6 +224,57 @@ fn main() -> ExitCode {
             last_words(format!("chassis: {message}\n"));
             ExitCode::from(code)
         }
+    }
+}
+
+/// Runs the command: `Err` with the message and the exit status. A command cut short by an
+/// ending (a signal, its terminal or input gone) exits with the ending's status.
+fn run(cli: &Cli) -> Result<(), (String, u8)> {
+    let failed = |e: String| (e, ending::ended().map_or(1, ending::Ending::exit_status));
+    let path = || port(cli.port.as_deref()).map_err(|e| (e, 1));
+    match &cli.command {
+        Cmd::Decode(args) => decode::run(args, cli.firmware).map_err(failed),
+        Cmd::Encode { frame } => {
+            say!("{}", encode::hex(&encode::encode(frame).map_err(failed)?));
+            Ok(())
+        }
+        Cmd::Sim {
+            pty,
+            tcp,
+            faults,
+            seed,
+        } => sim::run(*pty, tcp.as_deref(), cli.firmware, *faults, *seed).map_err(failed),
+        Cmd::Record { out, seconds } => record::record(path()?, out, *seconds).map_err(failed),
+        Cmd::Detect => connect::detect_command(path()?),
+        Cmd::Check(check) => {
+            let path = path()?;
+            let firmware = connect::generation_for_check(path, cli.firmware)?;
+            generation::of(firmware).check(path, check)
+        }
+        command => {
+            let path = path()?;
+            let firmware =
+                connect::generation_or(path, cli.firmware, command.belongs_to()).map_err(failed)?;
+            on_board(generation::of(firmware), path, command).map_err(failed)
+        }
+    }
+}
+
+/// A command that talks to a board, by the generation it runs.
+fn on_board(board: &dyn generation::Generation, path: &str, command: &Cmd) -> Result<(), String> {
+    match command {
+        Cmd::Get { register } => board.get(path, register),
+        Cmd::Set(set) => board.set(path, set),
+        Cmd::Settings { save, restore } => {
+            board.settings(path, save.as_deref(), restore.as_deref())
+        }
+        Cmd::Save => board.save(path),
+        Cmd::CalibrateGyro => board.calibrate_gyro(path),
+        Cmd::Stop => board.stop(path),
+        Cmd::Drive(drive) => board.drive(path, drive),
+        Cmd::Turn { degrees } => board.turn(path, *degrees),
+        Cmd::Monitor { drive, speed } => board.monitor(path, *drive, speed),
+        _ => Err("this command talks to no board".into()),
     }
 }
 
@@ -385,279 +325,6 @@ fn options(cli: &Cli) -> Result<(), (String, u8)> {
     Ok(())
 }
 
-/// Writes the frames found, one per line, and the summary on stderr.
-fn write_decoded(decoded: &decode::Decoded, format: decode::Format) -> Result<(), String> {
-    let stdout = std::io::stdout();
-    let mut out = std::io::BufWriter::new(stdout.lock());
-    let mut written = Ok(());
-    for found in &decoded.frames {
-        let line = match format {
-            decode::Format::Json => found.json.to_string(),
-            decode::Format::Text => found.text.clone(),
-        };
-        written = writeln!(out, "{line}");
-        if written.is_err() {
-            break;
-        }
-    }
-    if written.is_ok() {
-        written = out.flush();
-    }
-    match written {
-        // A closed pipe (`| head`): the reader has what it wanted.
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        Err(e) => Err(format!("standard output: {e}")),
-        Ok(()) => {
-            tell!("chassis decode: {}", decoded.summary);
-            Ok(())
-        }
-    }
-}
-
-/// The bytes of a capture (`None` or "-": standard input), at most [`input::CAPTURE_MAX`].
-fn read_input(file: Option<&str>) -> Result<Vec<u8>, String> {
-    input::read(file, input::CAPTURE_MAX, "capture")
-}
-
-/// A 2020 register by its name on the command line.
-fn register_2020(name: &str) -> Result<RegisterName, String> {
-    <RegisterName as clap::ValueEnum>::from_str(name, false).map_err(|_| {
-        let names: Vec<String> = <RegisterName as clap::ValueEnum>::value_variants()
-            .iter()
-            .filter_map(|v| clap::ValueEnum::to_possible_value(v).map(|p| p.get_name().to_string()))
-            .collect();
-        format!(
-            "{name:?} is not a register of the 2020 firmware: give one of {}",
-            names.join(", ")
-        )
-    })
-}
-
-/// The line for a command that has no meaning on v1.0.0.
-/// The generation a register or field name belongs to (a name of neither: 2020, whose error
-/// lists the names).
-fn names_generation(name: &str) -> Firmware {
-    let v1 = chassis_protocol::v1::Readback::from_name(name).is_some()
-        || chassis_protocol::v1::FIELDS.iter().any(|(n, _)| *n == name);
-    if v1 && chassis_protocol::Register::from_name(name).is_none() {
-        Firmware::V1_0_0
-    } else {
-        Firmware::V2020
-    }
-}
-
-fn not_on_v1(command: &str, why: &str) -> String {
-    format!("{command}: this board runs the v1.0.0 firmware, and {why}")
-}
-
-/// A command run from `main` that never reaches `run`.
-fn unreachable_in_run(command: &str) -> Result<(), String> {
-    Err(format!("{command}: its own exit status"))
-}
-
 fn port(cli_port: Option<&str>) -> Result<&str, String> {
     cli_port.ok_or_else(|| "this command talks to a board: give its serial port with --port PATH (or try `chassis sim --pty`)".to_string())
-}
-
-fn run(cli: Cli) -> Result<(), String> {
-    let p = cli.port.as_deref();
-    match cli.command {
-        Cmd::Decode {
-            file,
-            uplink,
-            master,
-            master_analyzer,
-            input,
-            format,
-            quiet_ms,
-        } => {
-            if !(quiet_ms > 0.0 && quiet_ms <= 60_000.0) {
-                return Err(format!(
-                    "--quiet-ms: {quiet_ms} is out of range (above 0, up to 60000)"
-                ));
-            }
-            let quiet = Some(quiet_ms / 1000.0);
-            if master.is_some()
-                && (master.as_deref() == Some("-") || file.as_deref().is_none_or(|f| f == "-"))
-            {
-                return Err(
-                    "--master: give both sides as files (standard input is one stream)".into(),
-                );
-            }
-            if master_analyzer.is_some() && input != decode::Input::SaleaeCsv {
-                return Err(
-                    "--master-analyzer reads a Saleae Logic 2 export: give --input saleae-csv"
-                        .into(),
-                );
-            }
-            let data = read_input(file.as_deref())?;
-            let firmware = cli.firmware;
-            if let Some(name) = master_analyzer {
-                let (mut board, mut master) = decode::parse_saleae_sides(&data, &name)?;
-                board.quiet_s = quiet;
-                master.quiet_s = quiet;
-                let decoded = decode::decode_both(&board, &master, firmware)?;
-                return write_decoded(&decoded, format);
-            }
-            let mut capture = decode::read_capture(&data, input)?;
-            capture.quiet_s = quiet;
-            let decoded = match master {
-                Some(path) => {
-                    let mut master = decode::read_capture(&read_input(Some(&path))?, input)?;
-                    master.quiet_s = quiet;
-                    decode::decode_both(&capture, &master, firmware)?
-                }
-                None => decode::decode(&capture, uplink, firmware),
-            };
-            write_decoded(&decoded, format)
-        }
-        Cmd::Encode { frame } => {
-            say!("{}", encode::hex(&encode::encode(&frame)?));
-            Ok(())
-        }
-        Cmd::Detect => unreachable_in_run("detect"),
-        Cmd::Get { register } => {
-            let path = port(p)?;
-            match connect::generation_or(path, cli.firmware, names_generation(&register))? {
-                Firmware::V2020 => device::get(path, register_2020(&register)?),
-                Firmware::V1_0_0 => v1cmd::get(path, &register),
-            }
-        }
-        Cmd::Set {
-            register,
-            value,
-            cutoff,
-            yes,
-        } => {
-            let path = port(p)?;
-            match connect::generation_or(path, cli.firmware, names_generation(&register))? {
-                Firmware::V2020 => device::set(
-                    path,
-                    register_2020(&register)?,
-                    &value,
-                    cutoff.as_deref(),
-                    yes,
-                ),
-                Firmware::V1_0_0 if cutoff.is_some() => Err(format!(
-                    "set {register}: one value on v1.0.0 (the cut-off is battery-range's, a 2020 register)"
-                )),
-                Firmware::V1_0_0 => v1cmd::set(path, &register, &value),
-            }
-        }
-        Cmd::Settings { save, restore } => {
-            let path = port(p)?;
-            match connect::generation(path, cli.firmware)? {
-                Firmware::V2020 => device::settings(path, save.as_deref(), restore.as_deref()),
-                Firmware::V1_0_0 => v1cmd::settings(path, save.as_deref(), restore.as_deref()),
-            }
-        }
-        Cmd::Save => {
-            let path = port(p)?;
-            match connect::generation(path, cli.firmware)? {
-                Firmware::V2020 => device::save(path),
-                Firmware::V1_0_0 => Err(not_on_v1(
-                    "save",
-                    "v1.0.0 has no frame that stores settings in flash (settings last until power-off: `chassis settings --save FILE` keeps them in a file)",
-                )),
-            }
-        }
-        Cmd::CalibrateGyro => {
-            let path = port(p)?;
-            match connect::generation(path, cli.firmware)? {
-                Firmware::V2020 => device::calibrate_gyro(path),
-                Firmware::V1_0_0 => Err(not_on_v1(
-                    "calibrate-gyro",
-                    "v1.0.0 has no gyro calibration frame",
-                )),
-            }
-        }
-        Cmd::Stop => {
-            let path = port(p)?;
-            match connect::generation(path, cli.firmware)? {
-                Firmware::V2020 => device::stop(path),
-                Firmware::V1_0_0 => v1cmd::stop(path),
-            }
-        }
-        Cmd::Drive {
-            axes,
-            vx,
-            vy,
-            wz,
-            seconds,
-        } => {
-            let path = port(p)?;
-            let si = vx.is_some() || vy.is_some() || wz.is_some();
-            let raw = [&axes.x, &axes.y, &axes.z]
-                .iter()
-                .any(|v| v.as_str() != "0");
-            let silent = if si {
-                Firmware::V1_0_0
-            } else {
-                Firmware::V2020
-            };
-            match connect::generation_or(path, cli.firmware, silent)? {
-                Firmware::V2020 if si => Err(
-                    "drive: --vx/--vy/--wz are for the v1.0.0 firmware; this board runs the 2020 one: give --x --y --z (the board's raw units)".into(),
-                ),
-                Firmware::V2020 => {
-                    let (x, y, z) = axes.values()?;
-                    device::drive(path, chassis_protocol::Velocity::new(x, y, z), seconds)
-                }
-                Firmware::V1_0_0 if raw => Err(
-                    "drive: --x/--y/--z are the 2020 firmware's raw units; this board runs v1.0.0: give --vx --vy (m/s) --wz (rad/s)".into(),
-                ),
-                Firmware::V1_0_0 => {
-                    let velocity = chassis_protocol::v1::BodyVelocity::new(
-                        v1cmd::milli(vx.unwrap_or(0.0), "vx", "m/s")?,
-                        v1cmd::milli(vy.unwrap_or(0.0), "vy", "m/s")?,
-                        v1cmd::milli(wz.unwrap_or(0.0), "wz", "rad/s")?,
-                    );
-                    v1cmd::drive(path, velocity, seconds)
-                }
-            }
-        }
-        Cmd::Turn { degrees } => {
-            let path = port(p)?;
-            match connect::generation(path, cli.firmware)? {
-                Firmware::V2020 => device::turn(path, degrees),
-                Firmware::V1_0_0 => Err(not_on_v1(
-                    "turn",
-                    "v1.0.0 has no turn by an angle (its protocol has none): `chassis drive --wz RAD/S --for SECONDS` turns at a rate",
-                )),
-            }
-        }
-        Cmd::Monitor { drive, speed } => {
-            let path = port(p)?;
-            match connect::generation(path, cli.firmware)? {
-                Firmware::V2020 => {
-                    let speed = value::parse_i32(&speed, "speed", 1, 65_535)?;
-                    monitor::run(path, drive, speed)
-                }
-                Firmware::V1_0_0 => {
-                    let speed = value::parse_i32(&speed, "speed", 1, 2_000)
-                        .map_err(|e| format!("{e}: on v1.0.0 the speed is in mm/s"))?;
-                    monitor::v1::run(path, drive, speed)
-                }
-            }
-        }
-        // Run from `main`: its exit status is the verdict.
-        Cmd::Check { .. } => unreachable_in_run("check"),
-        Cmd::Record { out, seconds } => record::record(port(p)?, &out, seconds),
-        Cmd::Sim {
-            pty,
-            tcp,
-            faults,
-            seed,
-        } => {
-            let firmware = cli
-                .firmware
-                .unwrap_or(chassis_protocol::detect::Firmware::V2020);
-            let faults = sim::faults(faults)?;
-            match (pty, tcp) {
-                (true, _) => sim::pty(firmware, seed, faults),
-                (false, Some(addr)) => sim::tcp(&addr, firmware, seed, faults),
-                (false, None) => Err("sim: give --pty or --tcp ADDR".into()),
-            }
-        }
-    }
 }

@@ -5,9 +5,9 @@
 //! input gone ([`crate::ending`]), with the file complete. The frames of both firmware
 //! generations are counted (it sends nothing, so it never asks which).
 
-use crate::device::explain;
 use crate::ending;
 use crate::port::{self, Recorder};
+use crate::stopping::explain;
 use chassis_protocol::driver::Event;
 use std::cell::Cell;
 use std::rc::Rc;

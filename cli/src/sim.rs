@@ -9,7 +9,7 @@ use std::sync::atomic::AtomicBool;
 use chassis_protocol::detect::Firmware;
 
 /// Line faults from a rate of errors per byte: a third each dropped, changed and added.
-pub fn faults(rate: f64) -> Result<Faults, String> {
+fn faults(rate: f64) -> Result<Faults, String> {
     if !(0.0..=0.5).contains(&rate) {
         return Err(format!(
             "--faults: {rate} errors per byte is out of range (0..=0.5)"
@@ -42,13 +42,57 @@ fn board_v1(seed: u64, faults: Faults) -> sim::v1::Board {
     board
 }
 
-/// Serves a simulated board on a new pseudo-terminal until the process is stopped; prints the
-/// path to open.
-#[cfg(unix)]
-pub fn pty(firmware: Firmware, seed: u64, faults: Faults) -> Result<(), String> {
-    match firmware {
-        Firmware::V2020 => on_pty(board(seed, faults), "try `chassis --port {path} settings`"),
-        Firmware::V1_0_0 => on_pty(board_v1(seed, faults), "firmware v1.0.0, 7B … 7D frames"),
+/// `chassis sim`: serves the simulated board of `firmware` (2020 unless given) on a new
+/// pseudo-terminal (`pty`) or to each client of a TCP listener on `tcp`, until the process is
+/// stopped; prints where.
+pub fn run(
+    pty: bool,
+    tcp: Option<&str>,
+    firmware: Option<Firmware>,
+    rate: f64,
+    seed: u64,
+) -> Result<(), String> {
+    let faults = faults(rate)?;
+    let place = match (pty, tcp) {
+        (true, _) => Place::Pty,
+        (false, Some(addr)) => Place::Tcp(addr),
+        (false, None) => return Err("sim: give --pty or --tcp ADDR".into()),
+    };
+    match firmware.unwrap_or(crate::connect::DEFAULT_FIRMWARE) {
+        Firmware::V2020 => place.serve(
+            || board(seed, faults),
+            Board::commands,
+            "try `chassis --port {path} settings`",
+        ),
+        Firmware::V1_0_0 => place.serve(
+            || board_v1(seed, faults),
+            sim::v1::Board::total_commands,
+            "firmware v1.0.0, 7B … 7D frames",
+        ),
+    }
+}
+
+/// Where the board is served.
+enum Place<'a> {
+    /// A new pseudo-terminal.
+    Pty,
+    /// A TCP listener on this address.
+    Tcp(&'a str),
+}
+
+impl Place<'_> {
+    /// Serves boards `fresh` makes; `commands` says how many commands one took; `hint` (with
+    /// `{path}` in it) follows a pseudo-terminal's path on stderr.
+    fn serve<B: Simulated>(
+        &self,
+        fresh: impl Fn() -> B,
+        commands: impl Fn(&B) -> u32,
+        hint: &str,
+    ) -> Result<(), String> {
+        match self {
+            Place::Pty => on_pty(fresh(), hint),
+            Place::Tcp(addr) => on_tcp(addr, fresh, commands),
+        }
     }
 }
 
@@ -79,21 +123,8 @@ fn on_pty<B: Simulated>(board: B, hint: &str) -> Result<(), String> {
 
 /// No pseudo-terminals off Unix.
 #[cfg(not(unix))]
-pub fn pty(_firmware: Firmware, _seed: u64, _faults: Faults) -> Result<(), String> {
+fn on_pty<B: Simulated>(_board: B, _hint: &str) -> Result<(), String> {
     Err("--pty needs a Unix pseudo-terminal; use --tcp".into())
-}
-
-/// Serves a simulated board to each client of a TCP listener on `addr`, one at a time, a fresh
-/// board each.
-pub fn tcp(addr: &str, firmware: Firmware, seed: u64, faults: Faults) -> Result<(), String> {
-    match firmware {
-        Firmware::V2020 => on_tcp(addr, || board(seed, faults), Board::commands),
-        Firmware::V1_0_0 => on_tcp(
-            addr,
-            || board_v1(seed, faults),
-            sim::v1::Board::total_commands,
-        ),
-    }
 }
 
 /// Serves a board `fresh` makes to each client of a TCP listener on `addr`; `commands` says

@@ -162,3 +162,21 @@ fn pending_turn<K: Spoken>(driver: &HostDriver<K>) -> String {
         String::new()
     }
 }
+
+/// Why the driver's failsafe stopped the chassis (`did`: what it did), from what came from the
+/// board: nothing at all, bytes of another firmware, or frames that stopped.
+pub fn failsafe_words<K: Spoken>(driver: &HostDriver<K>, did: &str) -> String {
+    let heard = unheard(driver).unwrap_or_else(|| "the board's frames stopped for a while".into());
+    let hint = if driver.core().heard_at(driver.uart().now_ms()) == Heard::Nothing {
+        " (is it powered, TX wired to RX and RX to TX, at 115200 bps?)"
+    } else {
+        ""
+    };
+    format!("{heard}{hint}: the driver's failsafe {did}")
+}
+
+/// The driver's logic error `e` in the CLI's words, told by what came from the board on
+/// `port`. Shared by every command and `chassis check` (and the Python package).
+pub fn core_words(e: chassis_protocol::driver::CoreError, heard: Heard, port: &str) -> String {
+    words_heard(e, heard, port)
+}

@@ -1,6 +1,6 @@
 //! `chassis monitor` on a board running the v1.0.0 firmware (`7B … BCC 7D`): its screen and
 //! its [`Chassis`]. The keys, the failsafe's hold, the link and the terminal are the 2020
-//! board's ([`super::Monitor`]); what differs is what the board says and how it is driven:
+//! board's ([`crate::monitor::Monitor`]); what differs is what the board says and how it is driven:
 //!
 //! * one telemetry frame at about 22 Hz: the measured body velocity (mm/s and mrad/s, shown in
 //!   m/s and rad/s), the yaw worked out from the quaternion, the gyro and accelerometer raw
@@ -10,7 +10,7 @@
 //! * the keys drive at `--speed` mm/s, `z` / `x` rotate at [`ROTATE_MRAD_S`], space sends the
 //!   forced stop; there is no turn by an angle (`t` only says so).
 
-use super::{Chassis, Status, drive_panel, keys_bar, rate_text, title_bar};
+use crate::monitor::{Chassis, Status, drive_panel, keys_bar, rate_text, title_bar};
 use crate::port::BoardV1;
 use chassis_protocol::driver::Error;
 use chassis_protocol::driver::host::SerialError;
@@ -288,7 +288,7 @@ impl Chassis for BoardV1Chassis {
 
 /// `chassis monitor [--drive]` on a v1.0.0 board: the keys drive at `speed` mm/s.
 pub fn run(port: &str, drive: bool, speed: i32) -> Result<(), String> {
-    super::run_monitor(
+    crate::monitor::run_monitor(
         || crate::port::open_v1(port, None).map(BoardV1Chassis::new),
         drive,
         speed,

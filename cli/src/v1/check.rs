@@ -10,9 +10,9 @@
 //! by an angle: its checks are eight, the turn a rotation at a rate.
 
 use crate::check::{Ending, confirm, ending, not_run, stopped_words};
-use crate::device::core_words;
 use crate::ending;
 use crate::port::{self, BoardV1, Port, SharedClock};
+use crate::stopping::core_words;
 use chassis_bringup::link::Blocking;
 use chassis_bringup::v1::{LinkV1, ReportV1, WhyV1, bring_up_v1};
 use chassis_bringup::{Check, Failure, LinkError, Note, Plan, Skip};

@@ -5,6 +5,11 @@
 //! whole-frame guarantee. What v1.0.0 has no frame for (a turn by an angle, storing in flash, a
 //! gyro calibration) is refused in one line.
 
+pub mod check;
+pub mod monitor;
+
+use crate::generation::{CheckArgs, DriveArgs, Generation, SetArgs};
+
 use crate::ending;
 use crate::port::{self, BoardV1};
 use crate::stopping::{self, Stopped};
@@ -253,7 +258,7 @@ pub fn drive(path: &str, velocity: BodyVelocity, seconds: f64) -> Result<(), Str
     }
     let seconds = seconds + 0.0;
     let mut driver = port::open_v1(path, None)?;
-    crate::device::before_motion()?;
+    crate::ending::before_motion()?;
     let start = Instant::now();
     let end = start + Duration::from_secs_f64(seconds);
     let ended = (|| -> Result<String, String> {
@@ -272,7 +277,7 @@ pub fn drive(path: &str, velocity: BodyVelocity, seconds: f64) -> Result<(), Str
                 std::thread::sleep(Duration::from_millis(2));
             }
             if driver.core().failsafe_stops() > 0 {
-                return Err(crate::device::failsafe_words(
+                return Err(crate::stopping::failsafe_words(
                     &driver,
                     "sent the forced stop",
                 ));
@@ -292,5 +297,94 @@ pub fn drive(path: &str, velocity: BodyVelocity, seconds: f64) -> Result<(), Str
         }
         (Ok(line), _) => Err(format!("{line}, but {words}")),
         (Err(e), _) => Err(format!("{e}; {words}")),
+    }
+}
+
+/// The line for a command v1.0.0 has no frame for: nothing was sent.
+fn not_here(command: &str, why: &str) -> String {
+    format!("{command}: this board runs the v1.0.0 firmware, and {why}")
+}
+
+/// The v1.0.0 firmware (`7B … BCC 7D` frames): the commands as it does them.
+pub struct V1;
+
+impl Generation for V1 {
+    fn get(&self, path: &str, name: &str) -> Result<(), String> {
+        get(path, name)
+    }
+
+    fn set(&self, path: &str, args: &SetArgs) -> Result<(), String> {
+        if args.cutoff.is_some() {
+            return Err(format!(
+                "set {}: one value on v1.0.0 (the cut-off is battery-range's, a 2020 register)",
+                args.register
+            ));
+        }
+        set(path, &args.register, &args.value)
+    }
+
+    fn settings(
+        &self,
+        path: &str,
+        save: Option<&str>,
+        restore: Option<&str>,
+    ) -> Result<(), String> {
+        settings(path, save, restore)
+    }
+
+    fn save(&self, _path: &str) -> Result<(), String> {
+        Err(not_here(
+            "save",
+            "v1.0.0 has no frame that stores settings in flash (settings last until power-off: `chassis settings --save FILE` keeps them in a file)",
+        ))
+    }
+
+    fn calibrate_gyro(&self, _path: &str) -> Result<(), String> {
+        Err(not_here(
+            "calibrate-gyro",
+            "v1.0.0 has no gyro calibration frame",
+        ))
+    }
+
+    fn stop(&self, path: &str) -> Result<(), String> {
+        stop(path)
+    }
+
+    fn drive(&self, path: &str, args: &DriveArgs) -> Result<(), String> {
+        if args.raw() {
+            return Err("drive: --x/--y/--z are the 2020 firmware's raw units; this board runs v1.0.0: give --vx --vy (m/s) --wz (rad/s)".into());
+        }
+        let velocity = BodyVelocity::new(
+            milli(args.vx.unwrap_or(0.0), "vx", "m/s")?,
+            milli(args.vy.unwrap_or(0.0), "vy", "m/s")?,
+            milli(args.wz.unwrap_or(0.0), "wz", "rad/s")?,
+        );
+        drive(path, velocity, args.seconds)
+    }
+
+    fn turn(&self, _path: &str, _degrees: f64) -> Result<(), String> {
+        Err(not_here(
+            "turn",
+            "v1.0.0 has no turn by an angle (its protocol has none): `chassis drive --wz RAD/S --for SECONDS` turns at a rate",
+        ))
+    }
+
+    fn monitor(&self, path: &str, drive: bool, speed: &str) -> Result<(), String> {
+        let speed = crate::value::parse_i32(speed, "speed", 1, 2_000)
+            .map_err(|e| format!("{e}: on v1.0.0 the speed is in mm/s"))?;
+        monitor::run(path, drive, speed)
+    }
+
+    fn check(&self, path: &str, args: &CheckArgs) -> Result<(), (String, u8)> {
+        if args.drive_type.is_some() {
+            return Err((
+                not_here(
+                    "check --drive-type",
+                    "it has no drive-type register (each velocity frame carries the vendor's type byte): run `chassis check` without it",
+                ),
+                1,
+            ));
+        }
+        check::check(path, args.no_motion, args.yes)
     }
 }

@@ -7,13 +7,17 @@
 //! the opposite turn sent). What it says of the chassis comes from what was sent and what came
 //! back ([`crate::stopping`]).
 
+pub mod check;
+pub mod monitor;
+
+use crate::generation::{CheckArgs, DriveArgs, Generation, SetArgs};
+
 use crate::encode::write_of;
 use crate::ending;
 use crate::names::{RegisterName, register_name};
 use crate::newfile::NewFile;
 use crate::port::{self, Board};
 use crate::stopping::{self, Stopped};
-use chassis_protocol::driver::host::Heard;
 use chassis_protocol::driver::host::SerialError;
 use chassis_protocol::driver::{CoreError, Error, Outcome, Request, TurnState};
 use chassis_protocol::{Action, Register, Snapshot, SystemMode, Velocity, Write};
@@ -28,12 +32,6 @@ pub fn open(port: &str) -> Result<Board, String> {
 /// came from the board.
 pub fn explain(driver: &Board, e: Error<SerialError>) -> String {
     stopping::explain(driver, e)
-}
-
-/// The driver's logic error `e` in the CLI's words, told by what came from the board on
-/// `port`. Shared by every command and `chassis check` (and the Python package).
-pub fn core_words(e: CoreError, heard: Heard, port: &str) -> String {
-    chassis_protocol::driver::host::words_heard(e, heard, port)
 }
 
 /// Reads `register` until two replies agree; its raw value.
@@ -260,30 +258,6 @@ pub fn save(port: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// Why the driver's failsafe stopped the chassis (`did`: what it did), from what came from the
-/// board: nothing at all, bytes of another firmware, or frames that stopped.
-pub fn failsafe_words<K: stopping::Spoken>(driver: &stopping::HostDriver<K>, did: &str) -> String {
-    let heard = stopping::unheard(driver)
-        .unwrap_or_else(|| "the board's frames stopped for a while".into());
-    let hint = if driver.core().heard_at(driver.uart().now_ms()) == Heard::Nothing {
-        " (is it powered, TX wired to RX and RX to TX, at 115200 bps?)"
-    } else {
-        ""
-    };
-    format!("{heard}{hint}: the driver's failsafe {did}")
-}
-
-/// `Err` when the command must end before anything that moves the chassis is sent: nothing was.
-pub fn before_motion() -> Result<(), String> {
-    match ending::ended() {
-        Some(end) => Err(format!(
-            "{}: the chassis was not moved (nothing that moves it was sent)",
-            end.words()
-        )),
-        None => Ok(()),
-    }
-}
-
 /// Polls the driver for `ms`, or until the command must end.
 fn poll_for(driver: &mut Board, ms: u64) -> Result<(), String> {
     let until = Instant::now() + Duration::from_millis(ms);
@@ -426,7 +400,7 @@ pub fn drive(port: &str, velocity: Velocity, seconds: f64) -> Result<(), String>
     // -0 is 0.
     let seconds = seconds + 0.0;
     let mut driver = open(port)?;
-    before_motion()?;
+    ending::before_motion()?;
     let start = Instant::now();
     let end = start + Duration::from_secs_f64(seconds);
     let bar = progress(
@@ -447,7 +421,7 @@ pub fn drive(port: &str, velocity: Velocity, seconds: f64) -> Result<(), String>
             }
             poll_for(&mut driver, 5)?;
             if driver.core().failsafe_stops() > 0 {
-                return Err(failsafe_words(&driver, "stopped it"));
+                return Err(stopping::failsafe_words(&driver, "stopped it"));
             }
             let done = start.elapsed().as_secs_f64().min(seconds);
             bar.set_position((done * 10.0) as u64);
@@ -473,7 +447,7 @@ pub fn turn(port: &str, degrees: f64) -> Result<(), String> {
     }
     let shown = f64::from(deci) / 10.0;
     let mut driver = open(port)?;
-    before_motion()?;
+    ending::before_motion()?;
     match driver.turn_by(deci) {
         Ok(()) => {}
         Err(Error::Core(CoreError::TurnInProgress)) => {
@@ -487,7 +461,7 @@ pub fn turn(port: &str, degrees: f64) -> Result<(), String> {
         }
         // Cut short before the turn went out (reading whether one is pending).
         Err(_) if driver.core().turn_state() == TurnState::Unknown && ending::ended().is_some() => {
-            before_motion()?;
+            ending::before_motion()?;
         }
         Err(e) if driver.core().turn_state() == TurnState::Unknown => {
             return Err(format!(
@@ -560,4 +534,85 @@ pub fn turn(port: &str, degrees: f64) -> Result<(), String> {
     bar.finish_and_clear();
     say!("{}", stop_after(&mut driver, ended)?);
     Ok(())
+}
+
+/// A 2020 register by its name on the command line.
+fn register(name: &str) -> Result<RegisterName, String> {
+    <RegisterName as clap::ValueEnum>::from_str(name, false).map_err(|_| {
+        let names: Vec<String> = <RegisterName as clap::ValueEnum>::value_variants()
+            .iter()
+            .filter_map(|v| clap::ValueEnum::to_possible_value(v).map(|p| p.get_name().to_string()))
+            .collect();
+        format!(
+            "{name:?} is not a register of the 2020 firmware: give one of {}",
+            names.join(", ")
+        )
+    })
+}
+
+/// The 2020 firmware (`FF FE` frames): the commands as it does them.
+pub struct V2020;
+
+impl Generation for V2020 {
+    fn get(&self, path: &str, name: &str) -> Result<(), String> {
+        get(path, register(name)?)
+    }
+
+    fn set(&self, path: &str, set_args: &SetArgs) -> Result<(), String> {
+        set(
+            path,
+            register(&set_args.register)?,
+            &set_args.value,
+            set_args.cutoff.as_deref(),
+            set_args.yes,
+        )
+    }
+
+    fn settings(
+        &self,
+        path: &str,
+        save: Option<&str>,
+        restore: Option<&str>,
+    ) -> Result<(), String> {
+        settings(path, save, restore)
+    }
+
+    fn save(&self, path: &str) -> Result<(), String> {
+        save(path)
+    }
+
+    fn calibrate_gyro(&self, path: &str) -> Result<(), String> {
+        calibrate_gyro(path)
+    }
+
+    fn stop(&self, path: &str) -> Result<(), String> {
+        stop(path)
+    }
+
+    fn drive(&self, path: &str, args: &DriveArgs) -> Result<(), String> {
+        if args.si() {
+            return Err("drive: --vx/--vy/--wz are for the v1.0.0 firmware; this board runs the 2020 one: give --x --y --z (the board's raw units)".into());
+        }
+        let (x, y, z) = args.axes.values()?;
+        drive(path, Velocity::new(x, y, z), args.seconds)
+    }
+
+    fn turn(&self, path: &str, degrees: f64) -> Result<(), String> {
+        turn(path, degrees)
+    }
+
+    fn monitor(&self, path: &str, drive: bool, speed: &str) -> Result<(), String> {
+        let speed = crate::value::parse_i32(speed, "speed", 1, 65_535)?;
+        monitor::run(path, drive, speed)
+    }
+
+    fn check(&self, path: &str, args: &CheckArgs) -> Result<(), (String, u8)> {
+        check::check(
+            path,
+            args.no_motion,
+            args.yes,
+            args.drive_type
+                .map(crate::generation::DriveTypeName::drive_type),
+        )
+    }
 }

@@ -1,0 +1,345 @@
+//! `chassis check`: the firmware's bring-up ([`chassis_bringup::bring_up`], the same code the
+//! boards under `mcu-example/boards/` run) from a PC, through the host driver: a progress line
+//! per check, a verdict on one screen, the exit status the verdict (0, or the failed check's
+//! code: the QEMU firmware's). `--no-motion` runs only what neither moves the chassis nor
+//! writes to the board. Before anything moves, a warning and a question (`--yes` answers it).
+//! SIGINT, SIGTERM and SIGHUP stop the chassis (a turn cancelled) and end the check.
+
+use crate::check::{Ending, confirm, ending, not_run, stopped_words};
+use crate::ending;
+use crate::port::{self, Board, Port, SharedClock};
+use crate::stopping::core_words;
+use chassis_bringup::link::Blocking;
+use chassis_bringup::{Check, Failure, Link, LinkError, Note, Plan, Report, Skip, Why, bring_up};
+use chassis_protocol::driver::host::Heard;
+use chassis_protocol::driver::{DriverCore, Error, Event};
+use chassis_protocol::registers::Snapshot;
+use chassis_protocol::{DriveType, Register, Stream, Turn, Velocity, Write};
+use std::io::Write as _;
+use std::time::Instant;
+/// What the check does to a chassis, said before it starts.
+const MOTION: &str = "the chassis will move: forward and sideways for 0.4 s each at speed 300, one 90° turn, then 1.5 s forward at 150. Give it about a metre of clear floor, or lift it so its wheels turn freely";
+
+/// The check's [`Link`]: the host driver, with a progress line per check and an ending (a
+/// signal, the terminal or input gone: [`crate::ending`]) turned into an error at the next call (the bring-up then stops the chassis itself).
+struct Checker {
+    inner: Blocking<Port, SharedClock>,
+    start: Instant,
+    step: Instant,
+    /// The checks done: passed (with what they measured) or skipped.
+    done: Vec<(Check, Option<String>)>,
+    /// How the last stop went (`None`: none was sent).
+    last_stop: Option<crate::check::StopRecord>,
+    /// The check under way.
+    current: Option<Check>,
+}
+
+impl Checker {
+    /// `Err` once the command must end: the bring-up fails its check and stops the chassis.
+    fn go_on(&self) -> Result<(), LinkError> {
+        match ending::ended() {
+            Some(_) => Err(Error::Transport(embedded_io::ErrorKind::Interrupted)),
+            None => Ok(()),
+        }
+    }
+
+    /// What a check measured, for its progress line.
+    fn detail(&self, check: Check) -> String {
+        let core = self.inner_core();
+        match check {
+            Check::Link => {
+                let frames = |s: Stream| core.stream(s).frames;
+                let seconds = self.step.elapsed().as_secs_f64();
+                format!(
+                    "{} IMU, {} encoder, {} battery frames in {seconds:.1} s",
+                    frames(Stream::Imu),
+                    frames(Stream::Encoders),
+                    frames(Stream::Battery)
+                )
+            }
+            Check::Battery => core.battery().map_or_else(String::new, |b| {
+                format!(
+                    "{}.{:02} V, {} %",
+                    b.value.centivolts / 100,
+                    b.value.centivolts % 100,
+                    b.value.percent
+                )
+            }),
+            _ => String::new(),
+        }
+    }
+
+    fn inner_core(&self) -> &DriverCore {
+        Link::core(&self.inner)
+    }
+}
+
+impl Link for Checker {
+    fn now_ms(&mut self) -> u64 {
+        self.inner.now_ms()
+    }
+    fn core(&self) -> &DriverCore {
+        self.inner_core()
+    }
+    fn poll(&mut self) -> Result<Option<Event>, LinkError> {
+        self.go_on()?;
+        self.inner.poll()
+    }
+    fn set_velocity(&mut self, velocity: Velocity) -> Result<(), LinkError> {
+        self.go_on()?;
+        self.inner.set_velocity(velocity)
+    }
+    fn stop(&mut self) -> Result<(), LinkError> {
+        // Never refused, never cut short: an ending is what a stop is for.
+        let driver = self.inner.driver();
+        driver.uart_mut().uninterrupted();
+        let before = driver.uart().stops_sent();
+        let result = self.inner.stop();
+        let driver = self.inner.driver();
+        self.last_stop = Some(crate::check::StopRecord {
+            result,
+            sent: driver.uart().stops_sent() > before,
+            unheard: crate::stopping::unheard_after_stop(driver),
+        });
+        result
+    }
+    fn turn(&mut self, turn: Turn) -> Result<(), LinkError> {
+        self.go_on()?;
+        self.inner.turn(turn)
+    }
+    fn turn_remaining(&mut self) -> Result<i32, LinkError> {
+        self.go_on()?;
+        self.inner.turn_remaining()
+    }
+    fn read_settings(&mut self) -> Result<Snapshot, LinkError> {
+        self.go_on()?;
+        self.inner.read_settings()
+    }
+    fn read_verified(&mut self, register: Register) -> Result<u32, LinkError> {
+        self.go_on()?;
+        self.inner.read_verified(register)
+    }
+    fn write(&mut self, write: Write) -> Result<(), LinkError> {
+        self.go_on()?;
+        self.inner.write(write)
+    }
+    fn note(&mut self, note: Note) {
+        let index = |c: Check| Check::ALL.iter().position(|x| *x == c).unwrap_or(0) + 1;
+        let mut out = std::io::stdout().lock();
+        match note {
+            Note::Start(check) => {
+                self.step = Instant::now();
+                self.current = Some(check);
+                let _ = write!(out, "[{}/9] {:<13}", index(check), check.name());
+            }
+            Note::Passed(check) => {
+                let detail = self.detail(check);
+                let _ = writeln!(
+                    out,
+                    "ok    {:>4.1} s  {detail}",
+                    self.step.elapsed().as_secs_f64(),
+                );
+                self.done.push((check, Some(detail)));
+                self.current = None;
+            }
+            Note::Skipped(check, why) => {
+                let _ = writeln!(
+                    out,
+                    "[{}/9] {:<13}skipped ({})",
+                    index(check),
+                    check.name(),
+                    match why {
+                        Skip::NoMotion => "--no-motion",
+                        Skip::DriveTypeKept => "the board's own kept: --drive-type sets one",
+                        Skip::NoSideways => "a differential chassis does not move sideways",
+                        Skip::NoEncoders => "no encoders on an open-loop differential chassis",
+                    }
+                );
+                self.done.push((check, None));
+            }
+        }
+        let _ = out.flush();
+    }
+}
+
+/// Why a check failed, in words.
+fn why(failure: &Failure, heard: Heard, port: &str) -> String {
+    match failure.why {
+        Why::Driver(Error::Transport(embedded_io::ErrorKind::Interrupted)) => {
+            "interrupted".into()
+        }
+        Why::Driver(Error::Core(e)) => core_words(e, heard, port),
+        Why::Driver(Error::Transport(kind)) => format!(
+            "the serial port failed ({kind:?}): was the adapter unplugged, or the board's power cut?"
+        ),
+        Why::Driver(e) => format!("the driver failed: {e:?}"),
+        Why::Rate(stream, per_10s) if heard == Heard::Nothing => format!(
+            "no telemetry ({stream:?} {:.1} Hz): is the board powered, TX wired to RX and RX to TX, at 115200 bps?",
+            f64::from(per_10s) / 10.0
+        ),
+        Why::Rate(stream, per_10s) => format!(
+            "{stream:?} frames come at {:.1} Hz, {} Hz expected",
+            f64::from(per_10s) / 10.0,
+            stream.rate_hz()
+        ),
+        Why::EncodersStill => "the encoders did not count: motors powered (motor-voltage)? encoders plugged in? wheels free?".into(),
+        Why::EncodersMoving => "the encoders kept counting after the stop".into(),
+        Why::GyroStill => "the gyro saw no rotation during the turn".into(),
+        Why::TurnPending(left) => format!(
+            "the turn was not done in time ({:.1}° still pending)",
+            f64::from(left) / 10.0
+        ),
+        Why::DriveTypeNotSet(read) => format!("the drive type reads back {read:?}"),
+        Why::LowBattery(centivolts, limit) => format!(
+            "the battery is at {:.2} V, its cut-off {:.2} V: charge it",
+            f64::from(centivolts) / 100.0,
+            f64::from(limit) / 100.0
+        ),
+        Why::NoBattery => "no battery frame came".into(),
+        Why::NoEncoderFrames => {
+            "no encoder frame came during the drive: the board went quiet".into()
+        }
+        Why::FailsafeStop => {
+            "the board went quiet: the driver's failsafe stopped the chassis".into()
+        }
+    }
+}
+
+/// The verdict of a passed check, one line per check.
+fn verdict(
+    report: &Report,
+    done: &[(Check, Option<String>)],
+    motion: bool,
+    seconds: f64,
+) -> String {
+    let passed = done.iter().filter(|(_, s)| s.is_some()).count();
+    let skipped = done.len() - passed;
+    let s = &report.snapshot;
+    let mut lines = vec![format!(
+        "PASS: {passed} checks passed{} in {seconds:.1} s",
+        if skipped > 0 {
+            format!(", {skipped} skipped")
+        } else {
+            String::new()
+        }
+    )];
+    for (check, state) in done {
+        let detail = match (check, state) {
+            (_, None) => "skipped".to_string(),
+            (Check::Link, Some(frames)) => format!(
+                "IMU {:.1} Hz, encoders {:.1} Hz ({frames})",
+                f64::from(report.rates_per_10s[0]) / 10.0,
+                f64::from(report.rates_per_10s[1]) / 10.0,
+            ),
+            (Check::Settings, _) => format!(
+                "max-speed {}, kp {}, ki {}, system-mode 0x{:X} ({:?}), motor-voltage {:.2} V, pending angle {:.1}°",
+                s.max_speed,
+                s.speed_kp,
+                s.speed_ki,
+                s.system_mode.bits(),
+                s.system_mode.drive_type(),
+                f64::from(s.motor_centivolts) / 100.0,
+                f64::from(report.pending_before) / 10.0
+            ),
+            (Check::DriveType, _) => "set".into(),
+            (Check::Forward, _) => format!("encoders counted {} ticks", report.ticks[0]),
+            (Check::Strafe, _) => format!("encoders counted {} ticks", report.ticks[1]),
+            (Check::Turn, _) => format!("90° done, gyro Z peak {}", report.gyro_peak),
+            (Check::Stop, _) => "encoders still".into(),
+            (Check::Battery, _) => format!(
+                "{:.2} V, {} %",
+                f64::from(report.battery.0) / 100.0,
+                report.battery.1
+            ),
+            (Check::ControlLoop, _) => format!(
+                "{} verified reads while moving, no failsafe stop",
+                report.loop_reads
+            ),
+        };
+        lines.push(format!("  {:<13} {detail}", check.name()));
+    }
+    lines.push(format!(
+        "  telemetry frames missed: {}; {}",
+        report.missed,
+        if motion {
+            "the chassis is stopped"
+        } else {
+            "nothing moved, nothing was written"
+        }
+    ));
+    lines.join("\n")
+}
+
+/// `chassis check [--no-motion] [--yes] [--drive-type TYPE]`.
+pub fn check(
+    path: &str,
+    no_motion: bool,
+    yes: bool,
+    drive: Option<DriveType>,
+) -> Result<(), (String, u8)> {
+    let failed = |e: String| (e, 1u8);
+    if !no_motion && !yes && !confirm(path, MOTION).map_err(failed)? {
+        return Err(failed("check cancelled: nothing was sent".into()));
+    }
+    let board: Board = port::open(path, None).map_err(failed)?;
+    let (uart, clock, core) = board.release();
+    let reader = clock.detached();
+    let driver = Board::from_core(uart, clock, core);
+    let mut link = Checker {
+        inner: Blocking::from_driver(driver, reader),
+        start: Instant::now(),
+        step: Instant::now(),
+        done: Vec::new(),
+        last_stop: None,
+        current: None,
+    };
+    say!(
+        "chassis check on {path}: {}",
+        if no_motion {
+            "link, registers and battery (only reads are sent: nothing moves, nothing is written)"
+        } else {
+            "every check (the chassis moves)"
+        }
+    );
+    let plan = Plan {
+        drive,
+        motion: !no_motion,
+        ..Plan::DEFAULT
+    };
+    let result = bring_up(&mut link, &plan);
+    let seconds = link.start.elapsed().as_secs_f64();
+    match result {
+        Ok(report) => {
+            say!("\n{}", verdict(&report, &link.done, !no_motion, seconds));
+            Ok(())
+        }
+        Err(failure) => {
+            let now = link.now_ms();
+            let heard = link.core().heard(now);
+            let stopped = stopped_words(link.last_stop, no_motion, false, |e| {
+                why(
+                    &Failure {
+                        check: failure.check,
+                        why: Why::Driver(e),
+                    },
+                    heard,
+                    path,
+                )
+            });
+            Err(ending(Ending {
+                check: failure.check.name(),
+                under_way: link.current.is_some(),
+                not_run: not_run(
+                    Check::ALL,
+                    failure.check,
+                    &link.done,
+                    no_motion,
+                    Check::name,
+                ),
+                stopped,
+                why: why(&failure, heard, path),
+                code: u8::try_from(failure.check.exit_code()).unwrap_or(1),
+            }))
+        }
+    }
+}

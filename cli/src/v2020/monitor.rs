@@ -1,0 +1,523 @@
+//! `chassis monitor` on a board running the 2020 firmware: its screen ([`View`], [`render`]) and
+//! its [`Chassis`] (the driver, the gyro Z history, the reads of a turn's pending angle). The
+//! keys, the failsafe's hold, the link and the terminal are shared ([`crate::monitor`]).
+
+use super::{explain, open};
+use crate::monitor::{Chassis, Status, drive_panel, keys_bar, rate_text, run_monitor, title_bar};
+use crate::port::Board;
+use crate::stopping;
+use chassis_protocol::driver::{CoreError, Error, Event as DriverEvent};
+use chassis_protocol::{Battery, Downlink, Encoders, Imu, Lock, Stream, Velocity};
+use ratatui::Frame;
+use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::text::Line;
+use ratatui::widgets::{Block, Gauge, Paragraph, Row, Sparkline, Table};
+use std::collections::VecDeque;
+use std::time::{Duration, Instant};
+
+/// Gyro Z readings kept for the sparkline.
+const HISTORY: usize = 120;
+
+/// How often the pending angle is read while a turn is outstanding.
+const TURN_READ: Duration = Duration::from_millis(250);
+
+/// What one stream looks like.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StreamView {
+    /// Frames per second, in thousandths.
+    pub rate_millihertz: u32,
+    /// Frames received.
+    pub frames: u32,
+    /// Frames missed by the count bytes.
+    pub missed: u32,
+}
+
+/// Everything the 2020 board's screen shows.
+#[derive(Clone, Debug, Default)]
+pub struct View {
+    /// The port.
+    pub port: String,
+    /// Whether a frame came lately.
+    pub link_alive: bool,
+    /// With the link down: how long ago the last frame came, in ms (the figures are that old).
+    pub stale_ms: Option<u64>,
+    /// The parser's certainty of where frames start.
+    pub lock: Option<Lock>,
+    /// Latest IMU frame.
+    pub imu: Option<Imu>,
+    /// Latest encoders frame.
+    pub encoders: Option<Encoders>,
+    /// Latest battery frame.
+    pub battery: Option<Battery>,
+    /// IMU, encoders, battery.
+    pub streams: [StreamView; 3],
+    /// Bytes the parser threw away.
+    pub discarded: u32,
+    /// Times the failsafe stopped the chassis.
+    pub failsafe_stops: u32,
+    /// |Gyro Z| history (how fast the chassis turns).
+    pub gyro_z: Vec<u64>,
+    /// Driving from the keyboard.
+    pub driving: bool,
+    /// The failsafe stopped the chassis: nothing moves until a key is pressed.
+    pub held: bool,
+    /// The speed keys drive at.
+    pub speed: i32,
+    /// The velocity being sent: x, y, z.
+    pub velocity: [i32; 3],
+    /// A turn is outstanding.
+    pub turning: bool,
+    /// The last message (errors, refusals).
+    pub message: String,
+}
+
+/// Draws the 2020 board's whole screen.
+pub fn render(frame: &mut Frame<'_>, view: &View) {
+    let [title, body, keys] = Layout::vertical([
+        Constraint::Length(1),
+        Constraint::Min(10),
+        Constraint::Length(3),
+    ])
+    .areas(frame.area());
+    let lock = match view.lock {
+        Some(Lock::Locked) => "locked",
+        Some(Lock::Tentative) => "tentative",
+        Some(Lock::Hunting) | None => "hunting",
+    };
+    title_bar(
+        frame,
+        title,
+        &view.port,
+        view.link_alive,
+        view.stale_ms,
+        format!(
+            "  failsafe stops {}  parser {lock}, {} bytes discarded",
+            view.failsafe_stops, view.discarded
+        ),
+    );
+    let [left, right] =
+        Layout::horizontal([Constraint::Percentage(55), Constraint::Percentage(45)]).areas(body);
+    let [imu_area, gyro_area, enc_area] = Layout::vertical([
+        Constraint::Length(4),
+        Constraint::Min(3),
+        Constraint::Length(3),
+    ])
+    .areas(left);
+    render_imu(frame, imu_area, view);
+    // The newest readings that fit, scaled to what was seen (never finer than the sensor's
+    // noise at rest).
+    let fit = usize::from(gyro_area.width.saturating_sub(2));
+    let recent = view
+        .gyro_z
+        .get(view.gyro_z.len().saturating_sub(fit)..)
+        .unwrap_or(&[]);
+    let peak = recent.iter().copied().max().unwrap_or(0).max(50);
+    frame.render_widget(
+        Sparkline::default()
+            .block(Block::bordered().title(format!(
+                " |gyro Z|, last {:.1} s (peak {peak}) ",
+                recent.len() as f64 / 100.0
+            )))
+            .data(recent.iter().copied())
+            .max(peak)
+            .style(Style::new().fg(Color::Cyan)),
+        gyro_area,
+    );
+    let enc = view.encoders.map_or_else(
+        || "—".to_string(),
+        |e| {
+            format!(
+                "M1 {:>6}  M2 {:>6}  M3 {:>6}  M4 {:>6}   count {}",
+                e.ticks[0], e.ticks[1], e.ticks[2], e.ticks[3], e.seq
+            )
+        },
+    );
+    frame.render_widget(
+        Paragraph::new(enc).block(Block::bordered().title(" encoders ")),
+        enc_area,
+    );
+
+    let [battery_area, streams_area, drive_area] = Layout::vertical([
+        Constraint::Length(3),
+        Constraint::Length(6),
+        Constraint::Min(4),
+    ])
+    .areas(right);
+    let (ratio, label) = match view.battery {
+        Some(b) => (
+            f64::from(b.percent.min(100)) / 100.0,
+            format!(
+                "{}.{:02} V  {} %",
+                b.centivolts / 100,
+                b.centivolts % 100,
+                b.percent
+            ),
+        ),
+        None => (0.0, "—".to_string()),
+    };
+    frame.render_widget(
+        Gauge::default()
+            .block(Block::bordered().title(" battery "))
+            .gauge_style(Style::new().fg(if ratio > 0.2 {
+                Color::Green
+            } else {
+                Color::Red
+            }))
+            .ratio(ratio)
+            .label(label),
+        battery_area,
+    );
+    let rows = ["IMU", "encoders", "battery"]
+        .iter()
+        .zip(view.streams.iter())
+        .map(|(name, s)| {
+            Row::new(vec![
+                (*name).to_string(),
+                rate_text(s.rate_millihertz, view.stale_ms),
+                s.frames.to_string(),
+                s.missed.to_string(),
+            ])
+        });
+    frame.render_widget(
+        Table::new(
+            rows,
+            [
+                Constraint::Length(9),
+                Constraint::Length(9),
+                Constraint::Length(8),
+                Constraint::Length(7),
+            ],
+        )
+        .header(
+            Row::new(vec!["stream", "rate", "frames", "missed"])
+                .style(Style::new().add_modifier(Modifier::BOLD)),
+        )
+        .block(Block::bordered().title(" streams ")),
+        streams_area,
+    );
+    drive_panel(
+        frame,
+        drive_area,
+        view.driving,
+        view.held,
+        format!(
+            "driving at {}: x {} y {} z {}{}",
+            view.speed,
+            view.velocity[0],
+            view.velocity[1],
+            view.velocity[2],
+            if view.turning { "  (turning)" } else { "" }
+        ),
+        &view.message,
+    );
+    keys_bar(
+        frame,
+        keys,
+        view.driving,
+        "arrows/WASD drive  space stop  t turn 90° once  +/- speed  q or Ctrl-C quit",
+    );
+}
+
+fn render_imu(frame: &mut Frame<'_>, area: Rect, view: &View) {
+    let lines = match view.imu {
+        Some(imu) => vec![
+            Line::from(format!(
+                "accel  x {:>6}  y {:>6}  z {:>6}",
+                imu.accel[0], imu.accel[1], imu.accel[2]
+            )),
+            Line::from(format!(
+                "gyro   x {:>6}  y {:>6}  z {:>6}   count {}",
+                imu.gyro[0], imu.gyro[1], imu.gyro[2], imu.seq
+            )),
+        ],
+        None => vec![Line::from("waiting for the IMU…")],
+    };
+    frame.render_widget(
+        Paragraph::new(lines).block(Block::bordered().title(" IMU ")),
+        area,
+    );
+}
+
+/// The 2020 board under the monitor: its driver, the gyro Z history, the next read of a
+/// turn's pending angle.
+pub struct Board2020 {
+    driver: Board,
+    history: VecDeque<i16>,
+    next_turn_read: Instant,
+}
+
+impl Board2020 {
+    /// The board behind `driver`.
+    pub fn new(driver: Board) -> Self {
+        Board2020 {
+            driver,
+            history: VecDeque::with_capacity(HISTORY),
+            next_turn_read: Instant::now(),
+        }
+    }
+}
+
+impl Chassis for Board2020 {
+    type View = View;
+
+    fn port(&self) -> &str {
+        self.driver.uart().name()
+    }
+
+    fn poll(&mut self) -> Result<bool, String> {
+        match self.driver.poll() {
+            Ok(Some(DriverEvent::Telemetry(Downlink::Imu(imu)))) => {
+                if self.history.len() == HISTORY {
+                    self.history.pop_front();
+                }
+                self.history.push_back(imu.gyro[2]);
+                Ok(true)
+            }
+            Ok(Some(_)) => Ok(true),
+            Ok(None) => Ok(false),
+            Err(e) => Err(explain(&self.driver, e)),
+        }
+    }
+
+    fn failsafe_stops(&self) -> u32 {
+        self.driver.core().failsafe_stops()
+    }
+
+    fn drive(&mut self, [x, y, z]: [i32; 3]) -> Result<(), String> {
+        self.driver
+            .set_velocity(Velocity::new(x, y, z))
+            .map_err(|e| explain(&self.driver, e))
+    }
+
+    fn stop(&mut self) -> Result<(), String> {
+        self.driver.stop().map_err(|e| explain(&self.driver, e))
+    }
+
+    fn stop_on_exit(&mut self) -> Result<String, String> {
+        let stopped = stopping::stop(&mut self.driver);
+        let words = stopped.words::<chassis_protocol::driver::DriverCore>();
+        if stopped.confirmed() {
+            Ok(words)
+        } else {
+            Err(words)
+        }
+    }
+
+    fn rotate_rate(&self) -> Result<i32, &'static str> {
+        Err("no rotate keys on the 2020 firmware: t turns 90°")
+    }
+
+    fn turn(&mut self, alive: bool) -> Result<String, String> {
+        if !alive {
+            return Err("no link: not turning".into());
+        }
+        match self.driver.turn_by(900) {
+            Ok(()) => {
+                self.next_turn_read = Instant::now() + TURN_READ;
+                Ok("turning 90° (sent once)".into())
+            }
+            Err(Error::Core(CoreError::TurnInProgress)) => {
+                Err("a turn is still going: not sent again".into())
+            }
+            Err(e) => Err(explain(&self.driver, e)),
+        }
+    }
+
+    fn follow_up(&mut self) -> Option<String> {
+        if self.driver.core().turning() && Instant::now() >= self.next_turn_read {
+            self.next_turn_read = Instant::now() + TURN_READ;
+            // A read lost is tried again at the next one.
+            if self.driver.turn_remaining().is_ok() && !self.driver.core().turning() {
+                return Some("turn done".into());
+            }
+        }
+        None
+    }
+
+    fn view(&self, status: Status) -> View {
+        let core = self.driver.core();
+        let mut streams = [StreamView::default(); 3];
+        for s in Stream::ALL {
+            let info = core.stream(s);
+            if let Some(v) = streams.get_mut(s.index()) {
+                *v = StreamView {
+                    rate_millihertz: info.rate_millihertz,
+                    frames: info.frames,
+                    missed: info.missed,
+                };
+            }
+        }
+        View {
+            port: status.port,
+            link_alive: status.link_alive,
+            stale_ms: status.stale_ms,
+            lock: Some(core.lock()),
+            imu: core.imu().map(|s| s.value),
+            encoders: core.encoders().map(|s| s.value),
+            battery: core.battery().map(|s| s.value),
+            streams,
+            discarded: core.parser_stats().discarded,
+            failsafe_stops: core.failsafe_stops(),
+            gyro_z: self
+                .history
+                .iter()
+                .map(|g| u64::from(g.unsigned_abs()))
+                .collect(),
+            driving: status.driving,
+            held: status.held,
+            speed: status.speed,
+            velocity: status.velocity,
+            turning: core.turning(),
+            message: status.message,
+        }
+    }
+
+    fn render(frame: &mut Frame<'_>, view: &View) {
+        render(frame, view);
+    }
+}
+
+/// `chassis monitor [--drive]` on a 2020 board.
+pub fn run(port: &str, drive: bool, speed: i32) -> Result<(), String> {
+    run_monitor(|| open(port).map(Board2020::new), drive, speed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ratatui::Terminal;
+    use ratatui::backend::TestBackend;
+
+    fn screen(view: &View) -> String {
+        let mut terminal = Terminal::new(TestBackend::new(100, 24)).unwrap();
+        terminal.draw(|f| render(f, view)).unwrap();
+        let buffer = terminal.backend().buffer().clone();
+        let mut text = String::new();
+        for y in 0..buffer.area.height {
+            for x in 0..buffer.area.width {
+                text.push_str(buffer[(x, y)].symbol());
+            }
+            text.push('\n');
+        }
+        text
+    }
+
+    #[test]
+    fn the_screen_shows_every_stream_the_link_and_the_keys() {
+        let view = View {
+            port: "/dev/ttyUSB0".into(),
+            link_alive: true,
+            stale_ms: None,
+            lock: Some(Lock::Locked),
+            imu: Some(Imu {
+                accel: [12, -7, 16_384],
+                gyro: [-3, 2, 450],
+                seq: 41,
+            }),
+            encoders: Some(Encoders {
+                ticks: [120, -118, 121, -119],
+                seq: 9,
+            }),
+            battery: Some(Battery {
+                centivolts: 1_187,
+                percent: 76,
+                seq: 3,
+            }),
+            streams: [
+                StreamView {
+                    rate_millihertz: 100_000,
+                    frames: 1_203,
+                    missed: 2,
+                },
+                StreamView {
+                    rate_millihertz: 25_000,
+                    frames: 301,
+                    missed: 0,
+                },
+                StreamView {
+                    rate_millihertz: 990,
+                    frames: 12,
+                    missed: 0,
+                },
+            ],
+            discarded: 17,
+            failsafe_stops: 0,
+            gyro_z: vec![3, 232, 450],
+            driving: true,
+            held: false,
+            speed: 300,
+            velocity: [0, 300, 0],
+            turning: true,
+            message: "turning 90° (sent once)".into(),
+        };
+        let text = screen(&view);
+        for needle in [
+            "chassis monitor",
+            "/dev/ttyUSB0",
+            "LINK UP",
+            "parser locked, 17 bytes discarded",
+            "failsafe stops 0",
+            "accel  x     12  y     -7  z  16384",
+            "gyro   x     -3  y      2  z    450   count 41",
+            "M1    120  M2   -118  M3    121  M4   -119",
+            "11.87 V  76 %",
+            "100.0 Hz",
+            "1203",
+            "25.0 Hz",
+            "1.0 Hz",
+            "peak 450",
+            "driving at 300: x 0 y 300 z 0  (turning)",
+            "turning 90° (sent once)",
+            "t turn 90° once",
+            "q or Ctrl-C quit",
+        ] {
+            assert!(text.contains(needle), "{needle:?} on the screen:\n{text}");
+        }
+    }
+
+    #[test]
+    fn a_silent_board_shows_no_link_and_waits() {
+        let text = screen(&View {
+            port: "/dev/ttyACM0".into(),
+            ..View::default()
+        });
+        assert!(text.contains("NO LINK"), "{text}");
+        assert!(text.contains("waiting for the IMU"), "{text}");
+        assert!(
+            text.contains("read only (start with --drive to drive)"),
+            "{text}"
+        );
+        assert!(text.contains("q quit"), "{text}");
+    }
+
+    #[test]
+    fn a_board_gone_quiet_shows_stale_figures_and_the_hold() {
+        let text = screen(&View {
+            port: "/dev/ttyUSB0".into(),
+            stale_ms: Some(3_200),
+            streams: [StreamView {
+                rate_millihertz: 100_000,
+                frames: 50,
+                missed: 0,
+            }; 3],
+            driving: true,
+            held: true,
+            failsafe_stops: 1,
+            ..View::default()
+        });
+        for needle in [
+            "NO LINK",
+            "STALE 3.2 s",
+            "stale",
+            "stopped by the failsafe: press a key",
+            "failsafe stops 1",
+        ] {
+            assert!(text.contains(needle), "{needle:?} on the screen:\n{text}");
+        }
+        assert!(
+            !text.contains("100.0 Hz"),
+            "no rate shown as if live:\n{text}"
+        );
+    }
+}
