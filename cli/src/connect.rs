@@ -3,7 +3,7 @@
 //! its two harmless probes), and `chassis detect`, which says it in one line.
 
 use crate::port;
-use chassis_protocol::detect::{self, Detection, Firmware, Heard};
+use chassis_protocol::detect::{self, Detection, Firmware};
 use chassis_protocol::driver::Config;
 use chassis_protocol::driver::host::MonotonicClock;
 
@@ -21,11 +21,7 @@ pub fn only_v1_name(name: &str) -> bool {
 
 /// `--firmware`: exactly `2020`, `v1.0.0` or `v1`.
 pub fn firmware_arg(name: &str) -> Result<Firmware, String> {
-    match name {
-        "2020" => Ok(Firmware::V2020),
-        "v1.0.0" | "v1" => Ok(Firmware::V1_0_0),
-        _ => Err("the board runs firmware 2020 or v1.0.0 (or v1)".into()),
-    }
+    Firmware::from_name(name).ok_or_else(|| "the board runs firmware 2020 or v1.0.0 (or v1)".into())
 }
 
 /// Exit status of `chassis detect` when nothing came from the board.
@@ -39,32 +35,6 @@ fn listen(path: &str) -> Result<Detection, String> {
     let mut clock = MonotonicClock::new();
     detect::detect(&mut serial, &mut clock, &Config::HOST)
         .map_err(|e| format!("serial port {path}: {}", e.0))
-}
-
-/// What was heard, in words: the frames, in `seconds`.
-fn heard_words(heard: &Heard, firmware: Firmware, seconds: f64) -> String {
-    match firmware {
-        Firmware::V2020 => format!(
-            "{} frames in {seconds:.1} s{}",
-            heard.frames_2020,
-            match heard.replies_2020 {
-                0 => String::new(),
-                _ => ", among them the answer to a register read".into(),
-            }
-        ),
-        Firmware::V1_0_0 => format!(
-            "{} frames in {seconds:.1} s, each with its BCC right{}{}",
-            heard.frames_v1,
-            match heard.bad_checksum_v1 {
-                0 => String::new(),
-                n => format!(" ({n} more with a wrong BCC: a noisy line?)"),
-            },
-            match heard.replies_v1 {
-                0 => String::new(),
-                _ => ", among them the answer to a readback".into(),
-            }
-        ),
-    }
 }
 
 /// The line `chassis detect` prints when nothing decided.
@@ -99,7 +69,7 @@ pub fn detect_command(path: &str) -> Result<(), (String, u8)> {
         "firmware {} ({}) on {path}: heard {}{}",
         firmware.name(),
         firmware.framing(),
-        heard_words(&found.heard, firmware, found.elapsed_ms as f64 / 1000.0),
+        crate::generation::of(firmware).heard(&found.heard, found.elapsed_ms as f64 / 1000.0),
         if found.probed {
             " (after a register read of each firmware: the board was quiet)"
         } else {

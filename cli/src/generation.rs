@@ -5,7 +5,9 @@
 //! refused by its own implementation, in one line, with nothing sent.
 
 use crate::encode::Axes;
-use chassis_protocol::detect::Firmware;
+use crate::sim::Place;
+use chassis_protocol::detect::{Firmware, Heard};
+use chassis_protocol::sim::Faults;
 use clap::Args;
 
 /// `chassis set` (both generations).
@@ -123,6 +125,10 @@ pub trait Generation: Sync {
     fn monitor(&self, path: &str, drive: bool, speed: &str) -> Result<(), String>;
     /// `check`: the bring-up from the PC; `Err` carries the exit status.
     fn check(&self, path: &str, check: &CheckArgs) -> Result<(), (String, u8)>;
+    /// What detection heard of this generation's frames in `seconds`, in words.
+    fn heard(&self, heard: &Heard, seconds: f64) -> String;
+    /// `sim`: serves this generation's simulated board at `place` until the process is stopped.
+    fn simulate(&self, place: &Place<'_>, seed: u64, faults: Faults) -> Result<(), String>;
 }
 
 /// The code that serves `firmware`.

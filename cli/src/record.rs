@@ -36,42 +36,8 @@ pub fn record(path: &str, out: &str, seconds: Option<f64>) -> Result<(), String>
             }
         }
     });
-    let bar = indicatif::ProgressBar::with_draw_target(
-        None,
-        indicatif::ProgressDrawTarget::stderr_with_hz(5),
-    );
-    if let Ok(style) =
-        indicatif::ProgressStyle::with_template("{spinner} recording {msg} (Ctrl-C ends it)")
-    {
-        bar.set_style(style);
-    }
     let start = Instant::now();
-    let end = seconds.map(|s| start + Duration::from_secs_f64(s));
-    let mut frames = 0u64;
-    let mut error = None;
-    while ending::ended().is_none() && end.is_none_or(|end| Instant::now() < end) {
-        match driver.poll() {
-            Ok(Some(Event::Telemetry(_) | Event::Reply(_) | Event::StrayReply(_))) => frames += 1,
-            // The poll waited up to a millisecond for a byte.
-            Ok(None) => {}
-            // A wait the ending cut short: the recording ends as it would on Ctrl-C.
-            Err(_) if ending::ended().is_some() => break,
-            Err(e) => {
-                error = Some(explain(&driver, e));
-                break;
-            }
-        }
-        let bytes = driver
-            .uart()
-            .recorder()
-            .map_or(0, |r| r.counts().board_bytes);
-        bar.set_message(format!(
-            "{} frames, {bytes} bytes, {:.0} s",
-            frames + v1_frames.get(),
-            start.elapsed().as_secs_f64()
-        ));
-    }
-    bar.finish_and_clear();
+    let (frames, error) = take_in(&mut driver, seconds, &v1_frames);
     let counts = driver
         .uart_mut()
         .finish_recording()
@@ -94,4 +60,51 @@ pub fn record(path: &str, out: &str, seconds: Option<f64>) -> Result<(), String>
             Ok(())
         }
     }
+}
+
+/// Takes in what the board sends until `seconds` have passed (or for ever) or the command must
+/// end, a spinner on stderr: the 2020 frames the driver took, and the error that ended it, if
+/// one did.
+fn take_in(
+    driver: &mut port::Board,
+    seconds: Option<f64>,
+    v1_frames: &Cell<u64>,
+) -> (u64, Option<String>) {
+    let bar = indicatif::ProgressBar::with_draw_target(
+        None,
+        indicatif::ProgressDrawTarget::stderr_with_hz(5),
+    );
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("{spinner} recording {msg} (Ctrl-C ends it)")
+    {
+        bar.set_style(style);
+    }
+    let start = Instant::now();
+    let end = seconds.map(|s| start + Duration::from_secs_f64(s));
+    let mut frames = 0u64;
+    let mut error = None;
+    while ending::ended().is_none() && end.is_none_or(|end| Instant::now() < end) {
+        match driver.poll() {
+            Ok(Some(Event::Telemetry(_) | Event::Reply(_) | Event::StrayReply(_))) => frames += 1,
+            // The poll waited up to a millisecond for a byte.
+            Ok(None) => {}
+            // A wait the ending cut short: the recording ends as it would on Ctrl-C.
+            Err(_) if ending::ended().is_some() => break,
+            Err(e) => {
+                error = Some(explain(driver, e));
+                break;
+            }
+        }
+        let bytes = driver
+            .uart()
+            .recorder()
+            .map_or(0, |r| r.counts().board_bytes);
+        bar.set_message(format!(
+            "{} frames, {bytes} bytes, {:.0} s",
+            frames + v1_frames.get(),
+            start.elapsed().as_secs_f64()
+        ));
+    }
+    bar.finish_and_clear();
+    (frames, error)
 }

@@ -24,7 +24,8 @@ fn faults(rate: f64) -> Result<Faults, String> {
     })
 }
 
-fn board(seed: u64, faults: Faults) -> Board {
+/// The 2020 board with `seed` and `faults`.
+pub fn board(seed: u64, faults: Faults) -> Board {
     let mut board = Board::new(SimConfig {
         seed,
         ..SimConfig::default()
@@ -33,7 +34,8 @@ fn board(seed: u64, faults: Faults) -> Board {
     board
 }
 
-fn board_v1(seed: u64, faults: Faults) -> sim::v1::Board {
+/// The v1.0.0 board with `seed` and `faults`.
+pub fn board_v1(seed: u64, faults: Faults) -> sim::v1::Board {
     let mut board = sim::v1::Board::new(sim::v1::SimConfig {
         seed,
         ..sim::v1::SimConfig::default()
@@ -58,22 +60,12 @@ pub fn run(
         (false, Some(addr)) => Place::Tcp(addr),
         (false, None) => return Err("sim: give --pty or --tcp ADDR".into()),
     };
-    match firmware.unwrap_or(crate::connect::DEFAULT_FIRMWARE) {
-        Firmware::V2020 => place.serve(
-            || board(seed, faults),
-            Board::commands,
-            "try `chassis --port {path} settings`",
-        ),
-        Firmware::V1_0_0 => place.serve(
-            || board_v1(seed, faults),
-            sim::v1::Board::total_commands,
-            "firmware v1.0.0, 7B … 7D frames",
-        ),
-    }
+    crate::generation::of(firmware.unwrap_or(crate::connect::DEFAULT_FIRMWARE))
+        .simulate(&place, seed, faults)
 }
 
 /// Where the board is served.
-enum Place<'a> {
+pub enum Place<'a> {
     /// A new pseudo-terminal.
     Pty,
     /// A TCP listener on this address.
@@ -83,7 +75,7 @@ enum Place<'a> {
 impl Place<'_> {
     /// Serves boards `fresh` makes; `commands` says how many commands one took; `hint` (with
     /// `{path}` in it) follows a pseudo-terminal's path on stderr.
-    fn serve<B: Simulated>(
+    pub fn serve<B: Simulated>(
         &self,
         fresh: impl Fn() -> B,
         commands: impl Fn(&B) -> u32,

@@ -46,6 +46,17 @@ impl Firmware {
         }
     }
 
+    /// The generation `name` names: `2020`, `v1.0.0` or `v1` (as [`Firmware::name`] writes it,
+    /// and v1.0.0's short form). Nothing else: `None`.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Firmware> {
+        match name {
+            "2020" => Some(Firmware::V2020),
+            "v1.0.0" | "v1" => Some(Firmware::V1_0_0),
+            _ => None,
+        }
+    }
+
     /// How its frames look.
     #[must_use]
     pub const fn framing(self) -> &'static str {

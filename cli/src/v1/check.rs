@@ -41,7 +41,8 @@ const fn name(check: Check) -> &'static str {
 }
 
 /// The check's [`LinkV1`]: the host driver, with a progress line per check and an ending (a
-/// signal, the terminal or input gone: [`crate::ending`]) turned into an error at the next call (the bring-up then sends the forced stop itself).
+/// signal, the terminal or input gone: [`crate::ending`]) turned into an error at the next
+/// call (the bring-up then sends the forced stop itself).
 struct CheckerV1 {
     inner: Blocking<Port, SharedClock, DriverCore>,
     start: Instant,
@@ -214,50 +215,11 @@ fn verdict(report: &ReportV1, done: &[(Check, bool)], motion: bool, seconds: f64
             String::new()
         }
     )];
-    let (system, geometry, pid) = (&report.system, &report.geometry, &report.pid);
     for (check, passed) in done {
-        let detail = match (check, passed) {
-            (_, false) => "skipped".to_string(),
-            (Check::Link, _) => format!(
-                "telemetry {:.1} Hz",
-                f64::from(report.telemetry_per_10s) / 10.0
-            ),
-            (Check::Settings, _) => format!(
-                "read back, nothing written: wheel diameter {} mm, wheel spacing {} mm, axle spacing {} mm, gear ratio {}, encoder {} PPR, PWM {}..{}, velocity PI {}/{}",
-                geometry.wheel_diameter_mm,
-                geometry.wheel_spacing_mm,
-                geometry.axle_spacing_mm,
-                geometry.gear_ratio,
-                system.encoder_ppr,
-                system.pwm_min,
-                system.pwm_max,
-                pid.velocity_kp,
-                pid.velocity_ki
-            ),
-            (Check::Forward, _) => format!(
-                "vy measured {:.3} m/s",
-                units(report.measured_mm_s[0].into())
-            ),
-            (Check::Strafe, _) => format!(
-                "vx measured {:.3} m/s",
-                units(report.measured_mm_s[1].into())
-            ),
-            (Check::Turn, _) => format!(
-                "yaw turned {:.2} rad ({:.2} expected), gyro z peak {} (raw)",
-                units(report.yaw_measured_mrad),
-                units(report.yaw_expected_mrad),
-                report.gyro_z_peak
-            ),
-            (Check::Stop, _) => format!(
-                "still after the forced stop (peaks |vx| {} |vy| {} mm/s, |wz| {} mrad/s)",
-                report.still_peak[0], report.still_peak[1], report.still_peak[2]
-            ),
-            (Check::Battery, _) => format!("{:.2} V", units(report.battery_mv.into())),
-            (Check::ControlLoop, _) => format!(
-                "telemetry {:.1} Hz while commanded, no failsafe stop",
-                f64::from(report.loop_per_10s) / 10.0
-            ),
-            (Check::DriveType, _) => "not on v1.0.0".into(),
+        let detail = if *passed {
+            passed_detail(*check, report)
+        } else {
+            "skipped".to_string()
         };
         lines.push(format!("  {:<13} {detail}", name(*check)));
     }
@@ -271,6 +233,53 @@ fn verdict(report: &ReportV1, done: &[(Check, bool)], motion: bool, seconds: f64
         }
     ));
     lines.join("\n")
+}
+
+/// What a passed check found, for its line of the verdict.
+fn passed_detail(check: Check, report: &ReportV1) -> String {
+    let (system, geometry, pid) = (&report.system, &report.geometry, &report.pid);
+    match check {
+        Check::Link => format!(
+            "telemetry {:.1} Hz",
+            f64::from(report.telemetry_per_10s) / 10.0
+        ),
+        Check::Settings => format!(
+            "read back, nothing written: wheel diameter {} mm, wheel spacing {} mm, axle spacing {} mm, gear ratio {}, encoder {} PPR, PWM {}..{}, velocity PI {}/{}",
+            geometry.wheel_diameter_mm,
+            geometry.wheel_spacing_mm,
+            geometry.axle_spacing_mm,
+            geometry.gear_ratio,
+            system.encoder_ppr,
+            system.pwm_min,
+            system.pwm_max,
+            pid.velocity_kp,
+            pid.velocity_ki
+        ),
+        Check::Forward => format!(
+            "vy measured {:.3} m/s",
+            units(report.measured_mm_s[0].into())
+        ),
+        Check::Strafe => format!(
+            "vx measured {:.3} m/s",
+            units(report.measured_mm_s[1].into())
+        ),
+        Check::Turn => format!(
+            "yaw turned {:.2} rad ({:.2} expected), gyro z peak {} (raw)",
+            units(report.yaw_measured_mrad),
+            units(report.yaw_expected_mrad),
+            report.gyro_z_peak
+        ),
+        Check::Stop => format!(
+            "still after the forced stop (peaks |vx| {} |vy| {} mm/s, |wz| {} mrad/s)",
+            report.still_peak[0], report.still_peak[1], report.still_peak[2]
+        ),
+        Check::Battery => format!("{:.2} V", units(report.battery_mv.into())),
+        Check::ControlLoop => format!(
+            "telemetry {:.1} Hz while commanded, no failsafe stop",
+            f64::from(report.loop_per_10s) / 10.0
+        ),
+        Check::DriveType => "not on v1.0.0".into(),
+    }
 }
 
 /// `chassis check [--no-motion] [--yes]` on a v1.0.0 board.

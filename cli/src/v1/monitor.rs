@@ -16,7 +16,7 @@ use chassis_protocol::driver::Error;
 use chassis_protocol::driver::host::SerialError;
 use chassis_protocol::v1::{BodyVelocity, Telemetry};
 use ratatui::Frame;
-use ratatui::layout::{Constraint, Layout};
+use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Style};
 use ratatui::text::Line;
 use ratatui::widgets::{Block, Paragraph};
@@ -90,87 +90,11 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
         Layout::vertical([Constraint::Length(10), Constraint::Min(4)]).areas(body);
     let [left, right] =
         Layout::horizontal([Constraint::Percentage(55), Constraint::Percentage(45)]).areas(top);
-    let [measured_area, imu_area] =
-        Layout::vertical([Constraint::Length(4), Constraint::Length(5)]).areas(left);
-    let stale = if status.stale_ms.is_some() {
-        " (stale)"
-    } else {
-        ""
-    };
-    let (measured, imu) = match view.telemetry {
-        Some(t) => {
-            let [vx, vy, wz] = t.velocity.map(i32::from);
-            let [ax, ay, az] = t.accel;
-            let [gx, gy, gz] = t.gyro;
-            let [qw, qx, qy, qz] = t.quaternion;
-            (
-                vec![
-                    Line::from(format!(
-                        "vx {:>7} m/s  vy {:>7} m/s  wz {:>7} rad/s",
-                        units(vx),
-                        units(vy),
-                        units(wz)
-                    )),
-                    Line::from(match yaw_degrees(t.quaternion) {
-                        Some(yaw) => format!("yaw {yaw:>7.1}°  (from the quaternion)"),
-                        None => "yaw —  (the quaternion is all zero)".into(),
-                    }),
-                ],
-                vec![
-                    Line::from(format!("accel raw  x {ax:>6}  y {ay:>6}  z {az:>6}")),
-                    Line::from(format!("gyro raw   x {gx:>6}  y {gy:>6}  z {gz:>6}")),
-                    Line::from(format!(
-                        "quaternion ×1000  w {qw:>5}  x {qx:>5}  y {qy:>5}  z {qz:>5}"
-                    )),
-                ],
-            )
-        }
-        None => (
-            vec![Line::from("waiting for the telemetry…")],
-            vec![Line::from("—")],
-        ),
-    };
-    frame.render_widget(
-        Paragraph::new(measured).block(Block::bordered().title(format!(" measured{stale} "))),
-        measured_area,
-    );
-    frame.render_widget(
-        Paragraph::new(imu).block(
-            Block::bordered().title(format!(" IMU (gyro, accel raw: scale unknown){stale} ")),
-        ),
-        imu_area,
-    );
-
+    render_motion(frame, left, view);
     let [battery_area, link_area] =
         Layout::vertical([Constraint::Length(3), Constraint::Length(7)]).areas(right);
-    let battery = view.telemetry.map(|t| i32::from(t.battery_mv));
-    frame.render_widget(
-        Paragraph::new(battery.map_or_else(
-            || "—".to_string(),
-            |mv| format!("{:.2} V  ({mv} mV)", f64::from(mv) / 1000.0),
-        ))
-        .style(Style::new().fg(match battery {
-            Some(mv) if mv >= 10_500 => Color::Green,
-            Some(_) => Color::Red,
-            None => Color::Reset,
-        }))
-        .block(Block::bordered().title(" battery ")),
-        battery_area,
-    );
-    frame.render_widget(
-        Paragraph::new(vec![
-            Line::from(format!(
-                "telemetry       {}",
-                rate_text(view.rate_millihertz, status.stale_ms)
-            )),
-            Line::from(format!("frames good     {}", view.frames)),
-            Line::from(format!("bad BCC         {}", view.bad_checksum)),
-            Line::from(format!("bytes discarded {}", view.discarded)),
-            Line::from(format!("failsafe stops  {}", view.failsafe_stops)),
-        ])
-        .block(Block::bordered().title(" link ")),
-        link_area,
-    );
+    render_battery(frame, battery_area, view);
+    render_link(frame, link_area, view);
     let [vx, vy, wz] = status.velocity;
     drive_panel(
         frame,
@@ -191,6 +115,101 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
         keys,
         status.driving,
         "arrows/WASD drive  z/x rotate 0.5 rad/s  space forced stop  +/- speed  q or Ctrl-C quit",
+    );
+}
+
+/// The left column: the measured velocity and yaw, the IMU.
+fn render_motion(frame: &mut Frame<'_>, area: Rect, view: &View) {
+    let [measured_area, imu_area] =
+        Layout::vertical([Constraint::Length(4), Constraint::Length(5)]).areas(area);
+    let stale = if view.status.stale_ms.is_some() {
+        " (stale)"
+    } else {
+        ""
+    };
+    let (measured, imu) = match view.telemetry {
+        Some(t) => (measured_lines(&t), imu_lines(&t)),
+        None => (
+            vec![Line::from("waiting for the telemetry…")],
+            vec![Line::from("—")],
+        ),
+    };
+    frame.render_widget(
+        Paragraph::new(measured).block(Block::bordered().title(format!(" measured{stale} "))),
+        measured_area,
+    );
+    frame.render_widget(
+        Paragraph::new(imu).block(
+            Block::bordered().title(format!(" IMU (gyro, accel raw: scale unknown){stale} ")),
+        ),
+        imu_area,
+    );
+}
+
+/// The measured body velocity and the yaw from the quaternion.
+fn measured_lines(t: &Telemetry) -> Vec<Line<'static>> {
+    let [vx, vy, wz] = t.velocity.map(i32::from);
+    vec![
+        Line::from(format!(
+            "vx {:>7} m/s  vy {:>7} m/s  wz {:>7} rad/s",
+            units(vx),
+            units(vy),
+            units(wz)
+        )),
+        Line::from(match yaw_degrees(t.quaternion) {
+            Some(yaw) => format!("yaw {yaw:>7.1}°  (from the quaternion)"),
+            None => "yaw —  (the quaternion is all zero)".into(),
+        }),
+    ]
+}
+
+/// The accelerometer and the gyro raw, the quaternion.
+fn imu_lines(t: &Telemetry) -> Vec<Line<'static>> {
+    let [ax, ay, az] = t.accel;
+    let [gx, gy, gz] = t.gyro;
+    let [qw, qx, qy, qz] = t.quaternion;
+    vec![
+        Line::from(format!("accel raw  x {ax:>6}  y {ay:>6}  z {az:>6}")),
+        Line::from(format!("gyro raw   x {gx:>6}  y {gy:>6}  z {gz:>6}")),
+        Line::from(format!(
+            "quaternion ×1000  w {qw:>5}  x {qx:>5}  y {qy:>5}  z {qz:>5}"
+        )),
+    ]
+}
+
+/// The battery, in volts.
+fn render_battery(frame: &mut Frame<'_>, area: Rect, view: &View) {
+    let battery = view.telemetry.map(|t| i32::from(t.battery_mv));
+    frame.render_widget(
+        Paragraph::new(battery.map_or_else(
+            || "—".to_string(),
+            |mv| format!("{:.2} V  ({mv} mV)", f64::from(mv) / 1000.0),
+        ))
+        .style(Style::new().fg(match battery {
+            Some(mv) if mv >= 10_500 => Color::Green,
+            Some(_) => Color::Red,
+            None => Color::Reset,
+        }))
+        .block(Block::bordered().title(" battery ")),
+        area,
+    );
+}
+
+/// The link's counters.
+fn render_link(frame: &mut Frame<'_>, area: Rect, view: &View) {
+    frame.render_widget(
+        Paragraph::new(vec![
+            Line::from(format!(
+                "telemetry       {}",
+                rate_text(view.rate_millihertz, view.status.stale_ms)
+            )),
+            Line::from(format!("frames good     {}", view.frames)),
+            Line::from(format!("bad BCC         {}", view.bad_checksum)),
+            Line::from(format!("bytes discarded {}", view.discarded)),
+            Line::from(format!("failsafe stops  {}", view.failsafe_stops)),
+        ])
+        .block(Block::bordered().title(" link ")),
+        area,
     );
 }
 

@@ -17,11 +17,13 @@ use chassis_protocol::registers::Snapshot;
 use chassis_protocol::{DriveType, Register, Stream, Turn, Velocity, Write};
 use std::io::Write as _;
 use std::time::Instant;
+
 /// What the check does to a chassis, said before it starts.
 const MOTION: &str = "the chassis will move: forward and sideways for 0.4 s each at speed 300, one 90° turn, then 1.5 s forward at 150. Give it about a metre of clear floor, or lift it so its wheels turn freely";
 
 /// The check's [`Link`]: the host driver, with a progress line per check and an ending (a
-/// signal, the terminal or input gone: [`crate::ending`]) turned into an error at the next call (the bring-up then stops the chassis itself).
+/// signal, the terminal or input gone: [`crate::ending`]) turned into an error at the next
+/// call (the bring-up then stops the chassis itself).
 struct Checker {
     inner: Blocking<Port, SharedClock>,
     start: Instant,
@@ -214,7 +216,6 @@ fn verdict(
 ) -> String {
     let passed = done.iter().filter(|(_, s)| s.is_some()).count();
     let skipped = done.len() - passed;
-    let s = &report.snapshot;
     let mut lines = vec![format!(
         "PASS: {passed} checks passed{} in {seconds:.1} s",
         if skipped > 0 {
@@ -224,37 +225,9 @@ fn verdict(
         }
     )];
     for (check, state) in done {
-        let detail = match (check, state) {
-            (_, None) => "skipped".to_string(),
-            (Check::Link, Some(frames)) => format!(
-                "IMU {:.1} Hz, encoders {:.1} Hz ({frames})",
-                f64::from(report.rates_per_10s[0]) / 10.0,
-                f64::from(report.rates_per_10s[1]) / 10.0,
-            ),
-            (Check::Settings, _) => format!(
-                "max-speed {}, kp {}, ki {}, system-mode 0x{:X} ({:?}), motor-voltage {:.2} V, pending angle {:.1}°",
-                s.max_speed,
-                s.speed_kp,
-                s.speed_ki,
-                s.system_mode.bits(),
-                s.system_mode.drive_type(),
-                f64::from(s.motor_centivolts) / 100.0,
-                f64::from(report.pending_before) / 10.0
-            ),
-            (Check::DriveType, _) => "set".into(),
-            (Check::Forward, _) => format!("encoders counted {} ticks", report.ticks[0]),
-            (Check::Strafe, _) => format!("encoders counted {} ticks", report.ticks[1]),
-            (Check::Turn, _) => format!("90° done, gyro Z peak {}", report.gyro_peak),
-            (Check::Stop, _) => "encoders still".into(),
-            (Check::Battery, _) => format!(
-                "{:.2} V, {} %",
-                f64::from(report.battery.0) / 100.0,
-                report.battery.1
-            ),
-            (Check::ControlLoop, _) => format!(
-                "{} verified reads while moving, no failsafe stop",
-                report.loop_reads
-            ),
+        let detail = match state {
+            None => "skipped".to_string(),
+            Some(frames) => passed_detail(*check, frames, report),
         };
         lines.push(format!("  {:<13} {detail}", check.name()));
     }
@@ -268,6 +241,43 @@ fn verdict(
         }
     ));
     lines.join("\n")
+}
+
+/// What a passed check found, for its line of the verdict (`frames`: what the link check
+/// counted).
+fn passed_detail(check: Check, frames: &str, report: &Report) -> String {
+    let s = &report.snapshot;
+    match check {
+        Check::Link => format!(
+            "IMU {:.1} Hz, encoders {:.1} Hz ({frames})",
+            f64::from(report.rates_per_10s[0]) / 10.0,
+            f64::from(report.rates_per_10s[1]) / 10.0,
+        ),
+        Check::Settings => format!(
+            "max-speed {}, kp {}, ki {}, system-mode 0x{:X} ({:?}), motor-voltage {:.2} V, pending angle {:.1}°",
+            s.max_speed,
+            s.speed_kp,
+            s.speed_ki,
+            s.system_mode.bits(),
+            s.system_mode.drive_type(),
+            f64::from(s.motor_centivolts) / 100.0,
+            f64::from(report.pending_before) / 10.0
+        ),
+        Check::DriveType => "set".into(),
+        Check::Forward => format!("encoders counted {} ticks", report.ticks[0]),
+        Check::Strafe => format!("encoders counted {} ticks", report.ticks[1]),
+        Check::Turn => format!("90° done, gyro Z peak {}", report.gyro_peak),
+        Check::Stop => "encoders still".into(),
+        Check::Battery => format!(
+            "{:.2} V, {} %",
+            f64::from(report.battery.0) / 100.0,
+            report.battery.1
+        ),
+        Check::ControlLoop => format!(
+            "{} verified reads while moving, no failsafe stop",
+            report.loop_reads
+        ),
+    }
 }
 
 /// `chassis check [--no-motion] [--yes] [--drive-type TYPE]`.
@@ -313,33 +323,37 @@ pub fn check(
             say!("\n{}", verdict(&report, &link.done, !no_motion, seconds));
             Ok(())
         }
-        Err(failure) => {
-            let now = link.now_ms();
-            let heard = link.core().heard(now);
-            let stopped = stopped_words(link.last_stop, no_motion, false, |e| {
-                why(
-                    &Failure {
-                        check: failure.check,
-                        why: Why::Driver(e),
-                    },
-                    heard,
-                    path,
-                )
-            });
-            Err(ending(Ending {
-                check: failure.check.name(),
-                under_way: link.current.is_some(),
-                not_run: not_run(
-                    Check::ALL,
-                    failure.check,
-                    &link.done,
-                    no_motion,
-                    Check::name,
-                ),
-                stopped,
-                why: why(&failure, heard, path),
-                code: u8::try_from(failure.check.exit_code()).unwrap_or(1),
-            }))
-        }
+        Err(failure) => Err(failed_line(&mut link, failure, path, no_motion)),
     }
+}
+
+/// The failure's line and exit status: why the check failed, what the stop after it did, the
+/// checks not run.
+fn failed_line(link: &mut Checker, failure: Failure, path: &str, no_motion: bool) -> (String, u8) {
+    let now = link.now_ms();
+    let heard = link.core().heard(now);
+    let stopped = stopped_words(link.last_stop.take(), no_motion, false, |e| {
+        why(
+            &Failure {
+                check: failure.check,
+                why: Why::Driver(e),
+            },
+            heard,
+            path,
+        )
+    });
+    ending(Ending {
+        check: failure.check.name(),
+        under_way: link.current.is_some(),
+        not_run: not_run(
+            Check::ALL,
+            failure.check,
+            &link.done,
+            no_motion,
+            Check::name,
+        ),
+        stopped,
+        why: why(&failure, heard, path),
+        code: u8::try_from(failure.check.exit_code()).unwrap_or(1),
+    })
 }

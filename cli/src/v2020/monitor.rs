@@ -36,12 +36,8 @@ pub struct StreamView {
 /// Everything the 2020 board's screen shows.
 #[derive(Clone, Debug, Default)]
 pub struct View {
-    /// The port.
-    pub port: String,
-    /// Whether a frame came lately.
-    pub link_alive: bool,
-    /// With the link down: how long ago the last frame came, in ms (the figures are that old).
-    pub stale_ms: Option<u64>,
+    /// The monitor's part: port, link, hold, what is sent, the message.
+    pub status: Status,
     /// The parser's certainty of where frames start.
     pub lock: Option<Lock>,
     /// Latest IMU frame.
@@ -58,22 +54,13 @@ pub struct View {
     pub failsafe_stops: u32,
     /// |Gyro Z| history (how fast the chassis turns).
     pub gyro_z: Vec<u64>,
-    /// Driving from the keyboard.
-    pub driving: bool,
-    /// The failsafe stopped the chassis: nothing moves until a key is pressed.
-    pub held: bool,
-    /// The speed keys drive at.
-    pub speed: i32,
-    /// The velocity being sent: x, y, z.
-    pub velocity: [i32; 3],
     /// A turn is outstanding.
     pub turning: bool,
-    /// The last message (errors, refusals).
-    pub message: String,
 }
 
 /// Draws the 2020 board's whole screen.
 pub fn render(frame: &mut Frame<'_>, view: &View) {
+    let status = &view.status;
     let [title, body, keys] = Layout::vertical([
         Constraint::Length(1),
         Constraint::Min(10),
@@ -88,9 +75,9 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
     title_bar(
         frame,
         title,
-        &view.port,
-        view.link_alive,
-        view.stale_ms,
+        &status.port,
+        status.link_alive,
+        status.stale_ms,
         format!(
             "  failsafe stops {}  parser {lock}, {} bytes discarded",
             view.failsafe_stops, view.discarded
@@ -98,12 +85,46 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
     );
     let [left, right] =
         Layout::horizontal([Constraint::Percentage(55), Constraint::Percentage(45)]).areas(body);
+    render_motion(frame, left, view);
+    let [battery_area, streams_area, drive_area] = Layout::vertical([
+        Constraint::Length(3),
+        Constraint::Length(6),
+        Constraint::Min(4),
+    ])
+    .areas(right);
+    render_battery(frame, battery_area, view.battery);
+    render_streams(frame, streams_area, view);
+    drive_panel(
+        frame,
+        drive_area,
+        status.driving,
+        status.held,
+        format!(
+            "driving at {}: x {} y {} z {}{}",
+            status.speed,
+            status.velocity[0],
+            status.velocity[1],
+            status.velocity[2],
+            if view.turning { "  (turning)" } else { "" }
+        ),
+        &status.message,
+    );
+    keys_bar(
+        frame,
+        keys,
+        status.driving,
+        "arrows/WASD drive  space stop  t turn 90° once  +/- speed  q or Ctrl-C quit",
+    );
+}
+
+/// The left column: the IMU, the |gyro Z| history, the encoders.
+fn render_motion(frame: &mut Frame<'_>, area: Rect, view: &View) {
     let [imu_area, gyro_area, enc_area] = Layout::vertical([
         Constraint::Length(4),
         Constraint::Min(3),
         Constraint::Length(3),
     ])
-    .areas(left);
+    .areas(area);
     render_imu(frame, imu_area, view);
     // The newest readings that fit, scaled to what was seen (never finer than the sensor's
     // noise at rest).
@@ -137,14 +158,11 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
         Paragraph::new(enc).block(Block::bordered().title(" encoders ")),
         enc_area,
     );
+}
 
-    let [battery_area, streams_area, drive_area] = Layout::vertical([
-        Constraint::Length(3),
-        Constraint::Length(6),
-        Constraint::Min(4),
-    ])
-    .areas(right);
-    let (ratio, label) = match view.battery {
+/// The battery gauge.
+fn render_battery(frame: &mut Frame<'_>, area: Rect, battery: Option<Battery>) {
+    let (ratio, label) = match battery {
         Some(b) => (
             f64::from(b.percent.min(100)) / 100.0,
             format!(
@@ -166,15 +184,19 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
             }))
             .ratio(ratio)
             .label(label),
-        battery_area,
+        area,
     );
+}
+
+/// The three streams: rate, frames, frames missed.
+fn render_streams(frame: &mut Frame<'_>, area: Rect, view: &View) {
     let rows = ["IMU", "encoders", "battery"]
         .iter()
         .zip(view.streams.iter())
         .map(|(name, s)| {
             Row::new(vec![
                 (*name).to_string(),
-                rate_text(s.rate_millihertz, view.stale_ms),
+                rate_text(s.rate_millihertz, view.status.stale_ms),
                 s.frames.to_string(),
                 s.missed.to_string(),
             ])
@@ -194,28 +216,7 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
                 .style(Style::new().add_modifier(Modifier::BOLD)),
         )
         .block(Block::bordered().title(" streams ")),
-        streams_area,
-    );
-    drive_panel(
-        frame,
-        drive_area,
-        view.driving,
-        view.held,
-        format!(
-            "driving at {}: x {} y {} z {}{}",
-            view.speed,
-            view.velocity[0],
-            view.velocity[1],
-            view.velocity[2],
-            if view.turning { "  (turning)" } else { "" }
-        ),
-        &view.message,
-    );
-    keys_bar(
-        frame,
-        keys,
-        view.driving,
-        "arrows/WASD drive  space stop  t turn 90° once  +/- speed  q or Ctrl-C quit",
+        area,
     );
 }
 
@@ -349,9 +350,7 @@ impl Chassis for Board2020 {
             }
         }
         View {
-            port: status.port,
-            link_alive: status.link_alive,
-            stale_ms: status.stale_ms,
+            status,
             lock: Some(core.lock()),
             imu: core.imu().map(|s| s.value),
             encoders: core.encoders().map(|s| s.value),
@@ -364,12 +363,7 @@ impl Chassis for Board2020 {
                 .iter()
                 .map(|g| u64::from(g.unsigned_abs()))
                 .collect(),
-            driving: status.driving,
-            held: status.held,
-            speed: status.speed,
-            velocity: status.velocity,
             turning: core.turning(),
-            message: status.message,
         }
     }
 
@@ -406,9 +400,16 @@ mod tests {
     #[test]
     fn the_screen_shows_every_stream_the_link_and_the_keys() {
         let view = View {
-            port: "/dev/ttyUSB0".into(),
-            link_alive: true,
-            stale_ms: None,
+            status: Status {
+                port: "/dev/ttyUSB0".into(),
+                link_alive: true,
+                stale_ms: None,
+                driving: true,
+                held: false,
+                speed: 300,
+                velocity: [0, 300, 0],
+                message: "turning 90° (sent once)".into(),
+            },
             lock: Some(Lock::Locked),
             imu: Some(Imu {
                 accel: [12, -7, 16_384],
@@ -444,12 +445,7 @@ mod tests {
             discarded: 17,
             failsafe_stops: 0,
             gyro_z: vec![3, 232, 450],
-            driving: true,
-            held: false,
-            speed: 300,
-            velocity: [0, 300, 0],
             turning: true,
-            message: "turning 90° (sent once)".into(),
         };
         let text = screen(&view);
         for needle in [
@@ -479,7 +475,10 @@ mod tests {
     #[test]
     fn a_silent_board_shows_no_link_and_waits() {
         let text = screen(&View {
-            port: "/dev/ttyACM0".into(),
+            status: Status {
+                port: "/dev/ttyACM0".into(),
+                ..Status::default()
+            },
             ..View::default()
         });
         assert!(text.contains("NO LINK"), "{text}");
@@ -494,15 +493,18 @@ mod tests {
     #[test]
     fn a_board_gone_quiet_shows_stale_figures_and_the_hold() {
         let text = screen(&View {
-            port: "/dev/ttyUSB0".into(),
-            stale_ms: Some(3_200),
+            status: Status {
+                port: "/dev/ttyUSB0".into(),
+                stale_ms: Some(3_200),
+                driving: true,
+                held: true,
+                ..Status::default()
+            },
             streams: [StreamView {
                 rate_millihertz: 100_000,
                 frames: 50,
                 missed: 0,
             }; 3],
-            driving: true,
-            held: true,
             failsafe_stops: 1,
             ..View::default()
         });
