@@ -34,6 +34,7 @@ macro_rules! tell_partial {
 mod check;
 mod connect;
 mod decode;
+mod driving;
 mod encode;
 mod ending;
 mod generation;

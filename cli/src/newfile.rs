@@ -80,3 +80,18 @@ impl Drop for NewFile {
         }
     }
 }
+
+/// `json` written to `out` (then put in place; "saved to PATH" on stderr), or to stdout.
+pub fn put_json(out: Option<NewFile>, json: &str) -> Result<(), String> {
+    match out {
+        Some(mut file) => {
+            use std::io::Write as _;
+            let path = file.path().to_string();
+            writeln!(file, "{json}").map_err(|e| format!("cannot write {path}: {e}"))?;
+            file.commit()?;
+            tell!("saved to {path}");
+        }
+        None => say!("{json}"),
+    }
+    Ok(())
+}

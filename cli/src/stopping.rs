@@ -14,6 +14,10 @@ pub trait Spoken: Core {
     const STOP: &'static str;
     /// The firmware's name: "2020", "v1.0.0".
     const FIRMWARE: &'static str;
+    /// How a drive's end says the chassis was stopped, after "stopped": "", " (forced stop)".
+    const STOPPED_HOW: &'static str;
+    /// Times the driver's failsafe has stopped the chassis.
+    fn failsafe_stops(&self) -> u32;
     /// What has come from the board, judged at `now_ms`.
     fn heard_at(&self, now_ms: u64) -> Heard;
     /// A turn the board may still have pending (a cancellation not confirmed).
@@ -25,6 +29,10 @@ pub trait Spoken: Core {
 impl Spoken for DriverCore {
     const STOP: &'static str = "the stop";
     const FIRMWARE: &'static str = "2020";
+    const STOPPED_HOW: &'static str = "";
+    fn failsafe_stops(&self) -> u32 {
+        DriverCore::failsafe_stops(self)
+    }
     fn heard_at(&self, now_ms: u64) -> Heard {
         self.heard(now_ms)
     }
@@ -37,6 +45,10 @@ impl Spoken for DriverCore {
 impl Spoken for v1::DriverCore {
     const STOP: &'static str = "the forced stop";
     const FIRMWARE: &'static str = "v1.0.0";
+    const STOPPED_HOW: &'static str = " (forced stop)";
+    fn failsafe_stops(&self) -> u32 {
+        v1::DriverCore::failsafe_stops(self)
+    }
     fn heard_at(&self, now_ms: u64) -> Heard {
         self.heard(now_ms)
     }

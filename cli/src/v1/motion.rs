@@ -3,6 +3,7 @@
 //! stop; cut short by any ending).
 
 use super::explain;
+use crate::driving;
 use crate::ending;
 use crate::port;
 use crate::stopping::{self, Stopped};
@@ -79,49 +80,15 @@ pub fn milli(value: f64, name: &str, unit: &str) -> Result<i16, String> {
 /// `chassis drive --vx --vy --wz --for S` on v1.0.0: the velocity re-sent every 50 ms, then
 /// the forced stop; on a signal, the forced stop at once.
 pub fn drive(path: &str, velocity: BodyVelocity, seconds: f64) -> Result<(), String> {
-    if !(0.0..=600.0).contains(&seconds) {
-        return Err(format!("--for: {seconds} s is out of range (0..=600)"));
-    }
-    let seconds = seconds + 0.0;
+    let seconds = driving::drive_seconds(seconds)?;
     let mut driver = port::open_v1(path, None)?;
-    crate::ending::before_motion()?;
-    let start = Instant::now();
-    let end = start + Duration::from_secs_f64(seconds);
-    let ended = (|| -> Result<String, String> {
-        let mut next = Instant::now();
-        while Instant::now() < end {
-            if let Some(end) = ending::ended() {
-                return Err(end.words());
-            }
-            if Instant::now() >= next {
-                driver
-                    .set_velocity(velocity)
-                    .map_err(|e| explain(&driver, e))?;
-                next += Duration::from_millis(50);
-            }
-            if driver.poll().map_err(|e| explain(&driver, e))?.is_none() {
-                std::thread::sleep(Duration::from_millis(2));
-            }
-            if driver.core().failsafe_stops() > 0 {
-                return Err(crate::stopping::failsafe_words(
-                    &driver,
-                    "sent the forced stop",
-                ));
-            }
-        }
-        Ok(format!("drove {seconds} s, stopped (forced stop)"))
-    })();
-    let stopped = stopping::stop(&mut driver);
-    let words = stopped.words::<DriverCore>();
-    if let Some(end) = ending::ended() {
-        return Err(format!("{}: {words}", end.words()));
-    }
-    match (ended, stopped) {
-        (Ok(line), Stopped::Confirmed) => {
-            say!("{line}");
-            Ok(())
-        }
-        (Ok(line), _) => Err(format!("{line}, but {words}")),
-        (Err(e), _) => Err(format!("{e}; {words}")),
-    }
+    ending::before_motion()?;
+    let line = driving::drive_for(
+        &mut driver,
+        seconds,
+        |driver| driver.set_velocity(velocity),
+        "sent the forced stop",
+    )?;
+    say!("{line}");
+    Ok(())
 }

@@ -151,15 +151,5 @@ pub fn settings(path: &str, save: Option<&str>, restore: Option<&str>) -> Result
         pid,
     };
     let json = serde_json::to_string_pretty(&saved).map_err(|e| e.to_string())?;
-    match out {
-        Some(mut file) => {
-            use std::io::Write as _;
-            let path = file.path().to_string();
-            writeln!(file, "{json}").map_err(|e| format!("cannot write {path}: {e}"))?;
-            file.commit()?;
-            tell!("saved to {path}");
-        }
-        None => say!("{json}"),
-    }
-    Ok(())
+    crate::newfile::put_json(out, &json)
 }

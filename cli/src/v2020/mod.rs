@@ -13,7 +13,6 @@ pub mod monitor;
 mod motion;
 mod settings;
 
-use crate::ending;
 use crate::generation::{CheckArgs, DriveArgs, Generation, SetArgs};
 use crate::names::RegisterName;
 use crate::port::{self, Board};
@@ -21,7 +20,6 @@ use crate::stopping;
 use chassis_protocol::Velocity;
 use chassis_protocol::driver::Error;
 use chassis_protocol::driver::host::SerialError;
-use std::time::{Duration, Instant};
 
 /// Opens the board's serial port with the host defaults.
 pub fn open(port: &str) -> Result<Board, String> {
@@ -32,17 +30,6 @@ pub fn open(port: &str) -> Result<Board, String> {
 /// came from the board.
 pub fn explain(driver: &Board, e: Error<SerialError>) -> String {
     stopping::explain(driver, e)
-}
-
-/// Polls the driver for `ms`, or until the command must end.
-pub(crate) fn poll_for(driver: &mut Board, ms: u64) -> Result<(), String> {
-    let until = Instant::now() + Duration::from_millis(ms);
-    while Instant::now() < until && ending::ended().is_none() {
-        if driver.poll().map_err(|e| explain(driver, e))?.is_none() {
-            std::thread::sleep(Duration::from_millis(2));
-        }
-    }
-    Ok(())
 }
 
 /// A 2020 register by its name on the command line.

@@ -2,45 +2,13 @@
 //! evidence), `drive` (a velocity re-sent every 50 ms, then the stop) and `turn` (sent once;
 //! followed until the pending angle is done; cancelled by any ending).
 
-use super::{explain, open, poll_for};
+use super::{explain, open};
+use crate::driving::{self, poll_for, progress, stop_after};
 use crate::ending;
 use crate::port::Board;
-use crate::stopping::{self, Stopped};
 use chassis_protocol::Velocity;
 use chassis_protocol::driver::{CoreError, Error, TurnState};
 use std::time::{Duration, Instant};
-
-/// Stops the chassis (cancelling a turn) and says how the command ended: `ended` is what
-/// happened (`Ok`: a line for stdout), the ending that cut it short comes first.
-fn stop_after(driver: &mut Board, ended: Result<String, String>) -> Result<String, String> {
-    let stopped = stopping::stop(driver);
-    let words = stopped.words::<chassis_protocol::driver::DriverCore>();
-    if let Some(end) = ending::ended() {
-        let end = end.words();
-        // A wait the ending cut short says only the ending's words: not said twice.
-        return Err(match ended {
-            Err(detail) if !detail.contains(&end) => format!("{end}: {detail}; {words}"),
-            _ => format!("{end}: {words}"),
-        });
-    }
-    match (ended, stopped) {
-        (Ok(line), Stopped::Confirmed) => Ok(line),
-        (Ok(line), _) => Err(format!("{line}, but {words}")),
-        (Err(e), _) => Err(format!("{e}; {words}")),
-    }
-}
-
-/// A progress bar on stderr (drawn only on a terminal).
-fn progress(len: u64, template: &str) -> indicatif::ProgressBar {
-    let bar = indicatif::ProgressBar::with_draw_target(
-        Some(len),
-        indicatif::ProgressDrawTarget::stderr_with_hz(10),
-    );
-    if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
-        bar.set_style(style);
-    }
-    bar
-}
 
 /// `chassis stop`: stops the chassis at once, then reads the angle the board has pending and
 /// cancels a turn it finds (left by a program that was killed, say). The read's answer is the
@@ -95,43 +63,16 @@ pub fn stop(port: &str) -> Result<(), String> {
 
 /// `chassis drive`: a velocity for a while, re-sent every 50 ms, then stop.
 pub fn drive(port: &str, velocity: Velocity, seconds: f64) -> Result<(), String> {
-    if !(0.0..=600.0).contains(&seconds) {
-        return Err(format!("--for: {seconds} s is out of range (0..=600)"));
-    }
-    // -0 is 0.
-    let seconds = seconds + 0.0;
+    let seconds = driving::drive_seconds(seconds)?;
     let mut driver = open(port)?;
     ending::before_motion()?;
-    let start = Instant::now();
-    let end = start + Duration::from_secs_f64(seconds);
-    let bar = progress(
-        (seconds * 10.0).round() as u64,
-        "driving {bar:30} {msg} (Ctrl-C stops)",
-    );
-    let ended = (|| -> Result<String, String> {
-        let mut next = Instant::now();
-        while Instant::now() < end {
-            if let Some(end) = ending::ended() {
-                return Err(end.words());
-            }
-            if Instant::now() >= next {
-                driver
-                    .set_velocity(velocity)
-                    .map_err(|e| explain(&driver, e))?;
-                next += Duration::from_millis(50);
-            }
-            poll_for(&mut driver, 5)?;
-            if driver.core().failsafe_stops() > 0 {
-                return Err(stopping::failsafe_words(&driver, "stopped it"));
-            }
-            let done = start.elapsed().as_secs_f64().min(seconds);
-            bar.set_position((done * 10.0) as u64);
-            bar.set_message(format!("{done:.1}/{seconds} s"));
-        }
-        Ok(format!("drove {seconds} s, stopped"))
-    })();
-    bar.finish_and_clear();
-    say!("{}", stop_after(&mut driver, ended)?);
+    let line = driving::drive_for(
+        &mut driver,
+        seconds,
+        |driver| driver.set_velocity(velocity),
+        "stopped it",
+    )?;
+    say!("{line}");
     Ok(())
 }
 

@@ -2,7 +2,8 @@
 //! gyro calibration needs `--yes`), `settings` (all of them as JSON, saved to a file or restored
 //! from one), `save` (into the board's flash) and `calibrate-gyro`.
 
-use super::{explain, open, poll_for};
+use super::{explain, open};
+use crate::driving::poll_for;
 use crate::encode::write_of;
 use crate::ending;
 use crate::names::{RegisterName, register_name};
@@ -213,17 +214,7 @@ pub fn settings(port: &str, save: Option<&str>, restore: Option<&str>) -> Result
     let mut driver = open(port)?;
     let snapshot = driver.read_settings().map_err(|e| explain(&driver, e))?;
     let json = serde_json::to_string_pretty(&snapshot).map_err(|e| e.to_string())?;
-    match out {
-        Some(mut file) => {
-            use std::io::Write as _;
-            let path = file.path().to_string();
-            writeln!(file, "{json}").map_err(|e| format!("cannot write {path}: {e}"))?;
-            file.commit()?;
-            tell!("saved to {path}");
-        }
-        None => say!("{json}"),
-    }
-    Ok(())
+    crate::newfile::put_json(out, &json)
 }
 
 /// `chassis save`: the current settings to the board's flash.
