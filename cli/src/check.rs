@@ -4,8 +4,89 @@
 //! generation's check is its bring-up from a PC: [`crate::v2020::check`], [`crate::v1::check`].
 
 use crate::ending;
+use crate::port::{Port, SharedClock};
+use crate::stopping::{HostDriver, Spoken};
+use chassis_bringup::link::Blocking;
 use chassis_bringup::{Check, LinkError};
+use chassis_protocol::driver::Error;
 use std::io::{BufRead, IsTerminal, Write as _};
+use std::time::Instant;
+
+/// A check under way on either generation: the bring-up's link over the host driver, and what
+/// its progress lines and its failure's line need. Each generation's check implements its
+/// bring-up's link on it; `T` is what a check done keeps (what it measured, or whether it
+/// passed).
+pub struct Session<K, T> {
+    /// The link over the host driver.
+    pub inner: Blocking<Port, SharedClock, K>,
+    /// When the check started.
+    pub start: Instant,
+    /// When the check under way started.
+    pub step: Instant,
+    /// Telemetry frames taken since the check under way started.
+    pub frames: u32,
+    /// The checks done.
+    pub done: Vec<(Check, T)>,
+    /// How the last stop went (`None`: none was sent).
+    pub last_stop: Option<StopRecord>,
+    /// The check under way.
+    pub current: Option<Check>,
+}
+
+impl<K: Spoken, T> Session<K, T> {
+    /// Asks before the chassis moves (`motion`: what it will do; not with `no_motion` or
+    /// `yes`), then opens the board on `path` with `open`.
+    pub fn open(
+        path: &str,
+        no_motion: bool,
+        yes: bool,
+        motion: &str,
+        open: impl FnOnce(&str) -> Result<HostDriver<K>, String>,
+    ) -> Result<Self, (String, u8)> {
+        let failed = |e: String| (e, 1u8);
+        if !no_motion && !yes && !confirm(path, motion).map_err(failed)? {
+            return Err(failed("check cancelled: nothing was sent".into()));
+        }
+        let (uart, clock, core) = open(path).map_err(failed)?.release();
+        let reader = clock.detached();
+        Ok(Session {
+            inner: Blocking::from_driver(HostDriver::from_core(uart, clock, core), reader),
+            start: Instant::now(),
+            step: Instant::now(),
+            frames: 0,
+            done: Vec::new(),
+            last_stop: None,
+            current: None,
+        })
+    }
+
+    /// `Err` once the command must end: the bring-up fails its check and stops the chassis.
+    pub fn go_on(&self) -> Result<(), LinkError> {
+        match ending::ended() {
+            Some(_) => Err(Error::Transport(embedded_io::ErrorKind::Interrupted)),
+            None => Ok(()),
+        }
+    }
+
+    /// The bring-up's stop (`stop`): never refused, never cut short (an ending is what a stop
+    /// is for), and what it did kept for the failure's line.
+    pub fn stop(
+        &mut self,
+        stop: impl FnOnce(&mut Blocking<Port, SharedClock, K>) -> Result<(), LinkError>,
+    ) -> Result<(), LinkError> {
+        let driver = self.inner.driver();
+        driver.uart_mut().uninterrupted();
+        let before = driver.uart().stops_sent();
+        let result = stop(&mut self.inner);
+        let driver = self.inner.driver();
+        self.last_stop = Some(StopRecord {
+            result,
+            sent: driver.uart().stops_sent() > before,
+            unheard: crate::stopping::unheard_after_stop(driver),
+        });
+        result
+    }
+}
 
 /// The checks of `order` that would have run after `failed` (not those a `--no-motion` run
 /// skips), by `name`: what a failed check's line lists as not run (both generations).

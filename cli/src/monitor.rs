@@ -459,3 +459,21 @@ where
     }
     Ok(())
 }
+
+/// The text a screen `render` draws from `view` on a 100 × 24 terminal (ratatui's test
+/// backend), a line per row: what the screens' tests read.
+#[cfg(test)]
+pub fn screen_text<V>(render: fn(&mut Frame<'_>, &V), view: &V) -> String {
+    let mut terminal =
+        ratatui::Terminal::new(ratatui::backend::TestBackend::new(100, 24)).expect("a terminal");
+    let _ = terminal.draw(|f| render(f, view));
+    let buffer = terminal.backend().buffer().clone();
+    let mut text = String::new();
+    for y in 0..buffer.area.height {
+        for x in 0..buffer.area.width {
+            text.push_str(buffer[(x, y)].symbol());
+        }
+        text.push('\n');
+    }
+    text
+}

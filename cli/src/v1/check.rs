@@ -9,11 +9,9 @@
 //! frames would overwrite what the owner tuned). v1.0.0 has no drive-type register and no turn
 //! by an angle: its checks are eight, the turn a rotation at a rate.
 
-use crate::check::{Ending, confirm, ending, not_run, stopped_words};
-use crate::ending;
-use crate::port::{self, BoardV1, Port, SharedClock};
+use crate::check::{Ending, Session, ending, not_run, stopped_words};
+use crate::port;
 use crate::stopping::core_words;
-use chassis_bringup::link::Blocking;
 use chassis_bringup::v1::{LinkV1, ReportV1, WhyV1, bring_up_v1};
 use chassis_bringup::{Check, Failure, LinkError, Note, Plan, Skip};
 use chassis_protocol::driver::Error;
@@ -42,30 +40,9 @@ const fn name(check: Check) -> &'static str {
 
 /// The check's [`LinkV1`]: the host driver, with a progress line per check and an ending (a
 /// signal, the terminal or input gone: [`crate::ending`]) turned into an error at the next
-/// call (the bring-up then sends the forced stop itself).
-struct CheckerV1 {
-    inner: Blocking<Port, SharedClock, DriverCore>,
-    start: Instant,
-    step: Instant,
-    /// Telemetry frames taken since the check under way started.
-    frames: u32,
-    /// The checks done: passed (`true`) or skipped.
-    done: Vec<(Check, bool)>,
-    /// How the last forced stop went (`None`: none was sent).
-    last_stop: Option<crate::check::StopRecord>,
-    /// The check under way.
-    current: Option<Check>,
-}
-
-impl CheckerV1 {
-    /// `Err` once the command must end: the bring-up fails its check and sends the forced stop.
-    fn go_on(&self) -> Result<(), LinkError> {
-        match ending::ended() {
-            Some(_) => Err(Error::Transport(embedded_io::ErrorKind::Interrupted)),
-            None => Ok(()),
-        }
-    }
-}
+/// call (the bring-up then sends the forced stop itself). A check done keeps whether it passed
+/// (`false`: skipped).
+type CheckerV1 = Session<DriverCore, bool>;
 
 impl LinkV1 for CheckerV1 {
     fn now_ms(&mut self) -> u64 {
@@ -87,18 +64,7 @@ impl LinkV1 for CheckerV1 {
         self.inner.set_velocity(velocity)
     }
     fn stop(&mut self) -> Result<(), LinkError> {
-        // Never refused, never cut short: an ending is what a stop is for.
-        let driver = self.inner.driver();
-        driver.uart_mut().uninterrupted();
-        let before = driver.uart().stops_sent();
-        let result = LinkV1::stop(&mut self.inner);
-        let driver = self.inner.driver();
-        self.last_stop = Some(crate::check::StopRecord {
-            result,
-            sent: driver.uart().stops_sent() > before,
-            unheard: crate::stopping::unheard_after_stop(driver),
-        });
-        result
+        Session::stop(self, LinkV1::stop)
     }
     fn readback(&mut self, readback: Readback) -> Result<Reply, LinkError> {
         self.go_on()?;
@@ -284,23 +250,9 @@ fn passed_detail(check: Check, report: &ReportV1) -> String {
 
 /// `chassis check [--no-motion] [--yes]` on a v1.0.0 board.
 pub fn check(path: &str, no_motion: bool, yes: bool) -> Result<(), (String, u8)> {
-    let failed = |e: String| (e, 1u8);
-    if !no_motion && !yes && !confirm(path, MOTION).map_err(failed)? {
-        return Err(failed("check cancelled: nothing was sent".into()));
-    }
-    let board: BoardV1 = port::open_v1(path, None).map_err(failed)?;
-    let (uart, clock, core) = board.release();
-    let reader = clock.detached();
-    let driver = BoardV1::from_core(uart, clock, core);
-    let mut link = CheckerV1 {
-        inner: Blocking::from_driver(driver, reader),
-        start: Instant::now(),
-        step: Instant::now(),
-        frames: 0,
-        done: Vec::new(),
-        last_stop: None,
-        current: None,
-    };
+    let mut link = CheckerV1::open(path, no_motion, yes, MOTION, |path| {
+        port::open_v1(path, None)
+    })?;
     say!(
         "chassis check on {path} (firmware v1.0.0): {}",
         if no_motion {

@@ -5,11 +5,9 @@
 //! writes to the board. Before anything moves, a warning and a question (`--yes` answers it).
 //! SIGINT, SIGTERM and SIGHUP stop the chassis (a turn cancelled) and end the check.
 
-use crate::check::{Ending, confirm, ending, not_run, stopped_words};
-use crate::ending;
-use crate::port::{self, Board, Port, SharedClock};
+use super::open;
+use crate::check::{Ending, Session, ending, not_run, stopped_words};
 use crate::stopping::core_words;
-use chassis_bringup::link::Blocking;
 use chassis_bringup::{Check, Failure, Link, LinkError, Note, Plan, Report, Skip, Why, bring_up};
 use chassis_protocol::driver::host::Heard;
 use chassis_protocol::driver::{DriverCore, Error, Event};
@@ -23,28 +21,11 @@ const MOTION: &str = "the chassis will move: forward and sideways for 0.4 s each
 
 /// The check's [`Link`]: the host driver, with a progress line per check and an ending (a
 /// signal, the terminal or input gone: [`crate::ending`]) turned into an error at the next
-/// call (the bring-up then stops the chassis itself).
-struct Checker {
-    inner: Blocking<Port, SharedClock>,
-    start: Instant,
-    step: Instant,
-    /// The checks done: passed (with what they measured) or skipped.
-    done: Vec<(Check, Option<String>)>,
-    /// How the last stop went (`None`: none was sent).
-    last_stop: Option<crate::check::StopRecord>,
-    /// The check under way.
-    current: Option<Check>,
-}
+/// call (the bring-up then stops the chassis itself). A check done keeps what it measured
+/// (`None`: skipped).
+type Checker = Session<DriverCore, Option<String>>;
 
 impl Checker {
-    /// `Err` once the command must end: the bring-up fails its check and stops the chassis.
-    fn go_on(&self) -> Result<(), LinkError> {
-        match ending::ended() {
-            Some(_) => Err(Error::Transport(embedded_io::ErrorKind::Interrupted)),
-            None => Ok(()),
-        }
-    }
-
     /// What a check measured, for its progress line.
     fn detail(&self, check: Check) -> String {
         let core = self.inner_core();
@@ -92,18 +73,7 @@ impl Link for Checker {
         self.inner.set_velocity(velocity)
     }
     fn stop(&mut self) -> Result<(), LinkError> {
-        // Never refused, never cut short: an ending is what a stop is for.
-        let driver = self.inner.driver();
-        driver.uart_mut().uninterrupted();
-        let before = driver.uart().stops_sent();
-        let result = self.inner.stop();
-        let driver = self.inner.driver();
-        self.last_stop = Some(crate::check::StopRecord {
-            result,
-            sent: driver.uart().stops_sent() > before,
-            unheard: crate::stopping::unheard_after_stop(driver),
-        });
-        result
+        Session::stop(self, |link| link.stop())
     }
     fn turn(&mut self, turn: Turn) -> Result<(), LinkError> {
         self.go_on()?;
@@ -287,22 +257,7 @@ pub fn check(
     yes: bool,
     drive: Option<DriveType>,
 ) -> Result<(), (String, u8)> {
-    let failed = |e: String| (e, 1u8);
-    if !no_motion && !yes && !confirm(path, MOTION).map_err(failed)? {
-        return Err(failed("check cancelled: nothing was sent".into()));
-    }
-    let board: Board = port::open(path, None).map_err(failed)?;
-    let (uart, clock, core) = board.release();
-    let reader = clock.detached();
-    let driver = Board::from_core(uart, clock, core);
-    let mut link = Checker {
-        inner: Blocking::from_driver(driver, reader),
-        start: Instant::now(),
-        step: Instant::now(),
-        done: Vec::new(),
-        last_stop: None,
-        current: None,
-    };
+    let mut link = Checker::open(path, no_motion, yes, MOTION, open)?;
     say!(
         "chassis check on {path}: {}",
         if no_motion {
