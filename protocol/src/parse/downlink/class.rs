@@ -1,0 +1,248 @@
+//! What a candidate is ([`Class`]): its count against the line's, and the suspicions a frame
+//! can raise (inside a frame rejected on a boundary, a header for its count byte, a frame
+//! nested in it, in a reply's value); and where it starts ([`Start`]).
+
+use super::counts::Rel;
+use super::rules::{Class, Start};
+use super::{DownlinkParser, Lock};
+use crate::telemetry::{self, Downlink, Kind, Stream};
+
+impl DownlinkParser {
+    /// What the candidate `frame`, starting `at` bytes into the window, is.
+    pub(super) fn class(&self, frame: &Downlink, at: usize) -> Class {
+        match frame {
+            // (Inside a frame rejected on a boundary, the awaited code is no evidence either:
+            // row 12.)
+            Downlink::Reply(reply)
+                if self.expect == Some(reply.code)
+                    && !(self.lock == Lock::Hunting && self.in_shadow() && at == 0) =>
+            {
+                Class::Expected {
+                    clean: !holds_a_frame_start(reply.encode().get(2..).unwrap_or(&[])),
+                }
+            }
+            Downlink::Reply(_) => Class::Unexpected,
+            _ if self.lock == Lock::Hunting
+                && at == 0
+                && (self.in_shadow()
+                    && (!self.near(frame) && self.nests_a_frame(frame, &[0])
+                        || self.overlaps_the_rejected_frames_next(frame)
+                        || self.is_the_rejected_frames_tail(frame))
+                    || self.nests_a_frame(frame, &[1, -1])
+                    || self.in_a_replys_value(frame)
+                    || self.inside_a_headless_frame(frame)) =>
+            {
+                Class::Nested
+            }
+            _ => match (frame.kind(), frame.seq()) {
+                (Kind::Telemetry(stream), Some(seq)) => {
+                    let cut = self.ends_with_a_header(frame, at);
+                    match self.counts.rel(stream, seq, at) {
+                        // (Inside a frame rejected on a boundary, a continuing count is no
+                        // evidence, nor one that is a header's second byte: row 9.)
+                        Rel::Continues | Rel::Near
+                            if self.lock == Lock::Hunting
+                                && (self.in_shadow() && at == 0
+                                    || self.other_stream_fits(stream, seq, at)
+                                    || cut) =>
+                        {
+                            Class::Ambiguous
+                        }
+                        Rel::Continues => Class::Continues,
+                        Rel::Near => Class::Near,
+                        Rel::Unknown => Class::First,
+                        Rel::Far if cut => Class::Cut,
+                        Rel::Far => Class::Far,
+                    }
+                }
+                _ => Class::Unexpected,
+            },
+        }
+    }
+
+    /// Inside a frame rejected on a boundary: whether a telemetry header lies inside the
+    /// candidate `frame` (at the window's front) right where that frame, had it lost or gained a
+    /// byte, would end: where the frame after it starts.
+    pub(super) fn overlaps_the_rejected_frames_next(&self, frame: &Downlink) -> bool {
+        let end = usize::from(self.thrown.rejected_left).saturating_sub(2);
+        let len = frame.kind().len();
+        let buf = self.buf.as_slice();
+        [end.wrapping_sub(1), end.saturating_add(1)]
+            .into_iter()
+            .filter(|at| (1..=len.saturating_sub(2)).contains(at))
+            .any(|at| {
+                buf.get(at..at.saturating_add(2))
+                    .and_then(telemetry_header)
+                    .is_some()
+            })
+    }
+
+    /// Inside a frame rejected on a boundary: whether the candidate `frame` (at the window's
+    /// front) is of the rejected frame's kind and starts two bytes into it, so that it ends
+    /// where that frame ends if it gained two bytes, on its count byte: its payload from there.
+    pub(super) fn is_the_rejected_frames_tail(&self, frame: &Downlink) -> bool {
+        self.thrown.rejected == Some(frame.kind())
+            && usize::from(self.thrown.rejected_left) == frame.kind().len()
+    }
+
+    /// Whether the last two bytes of the candidate `frame`, starting `at` bytes into the window,
+    /// are a telemetry header.
+    pub(super) fn ends_with_a_header(&self, frame: &Downlink, at: usize) -> bool {
+        let end = at.saturating_add(frame.kind().len());
+        self.buf
+            .as_slice()
+            .get(end.saturating_sub(2)..end)
+            .and_then(telemetry_header)
+            .is_some()
+    }
+
+    /// Whether the telemetry candidate `frame` at the front of the window ends with a frame of
+    /// another stream whose count (the candidate's) continues (or is near) that stream's; that
+    /// frame's bytes there number its length plus one of `damage` (0: whole; -1: it lost a
+    /// byte; 1: it gained one).
+    pub(super) fn nests_a_frame(&self, frame: &Downlink, damage: &[i8]) -> bool {
+        let (Kind::Telemetry(outer), Some(seq)) = (frame.kind(), frame.seq()) else {
+            return false;
+        };
+        let len = frame.kind().len();
+        let bytes = self.buf.as_slice().get(..len).unwrap_or(&[]);
+        // Only the places where such a frame would start are looked at.
+        Stream::ALL.iter().any(|inner| {
+            *inner != outer
+                && damage.iter().any(|d| {
+                    let inner_len = Kind::Telemetry(*inner)
+                        .len()
+                        .saturating_add_signed(isize::from(*d));
+                    len.checked_sub(inner_len)
+                        .filter(|off| *off > 0)
+                        .is_some_and(|off| {
+                            bytes
+                                .get(off..off.saturating_add(2))
+                                .and_then(telemetry_header)
+                                == Some(*inner)
+                                && matches!(
+                                    self.counts.rel(*inner, seq, off),
+                                    Rel::Continues | Rel::Near
+                                )
+                        })
+                })
+        })
+    }
+
+    /// Whether the telemetry candidate `frame` at the front of the window starts in a reply's
+    /// value (the two bytes thrown away right before it are `23` and a reply code) and its
+    /// tail, from where that reply ends, is a whole frame of another stream whose count (the
+    /// candidate's) fits that stream: the reply and that frame are real, the candidate
+    /// straddles them (a value starting `FF FA`).
+    pub(super) fn in_a_replys_value(&self, frame: &Downlink) -> bool {
+        let (Kind::Telemetry(outer), Some(seq)) = (frame.kind(), frame.seq()) else {
+            return false;
+        };
+        let [code, hash, ..] = self.thrown.before.to_le_bytes();
+        if self.thrown.before_len < 2 || Kind::from_header(hash, code) != Some(Kind::Reply) {
+            return false;
+        }
+        let len = frame.kind().len();
+        let off = Kind::Reply.len().saturating_sub(2);
+        let bytes = self.buf.as_slice().get(..len).unwrap_or(&[]);
+        bytes
+            .get(off..off.saturating_add(2))
+            .and_then(telemetry_header)
+            .is_some_and(|inner| {
+                inner != outer
+                    && Kind::Telemetry(inner).len().saturating_add(off) == len
+                    && matches!(self.counts.rel(inner, seq, off), Rel::Continues | Rel::Near)
+            })
+    }
+
+    /// Whether the telemetry candidate `frame` at the front of the window is the tail of a
+    /// frame of another stream that lost its first byte: that frame's second header byte
+    /// (`FA`..`FC`, not after an `FF`; after a frame taken or a quiet line, the byte before it
+    /// is not known) among the bytes thrown away right before it, where the rest of that frame
+    /// ends on the candidate's count byte, which fits that stream.
+    pub(super) fn inside_a_headless_frame(&self, frame: &Downlink) -> bool {
+        let (Kind::Telemetry(own), Some(seq)) = (frame.kind(), frame.seq()) else {
+            return false;
+        };
+        let len = frame.kind().len();
+        // The byte `back` bytes before the window's first, if it was seen.
+        let seen = self.thrown.before.to_le_bytes();
+        let before = |back: usize| {
+            seen.get(back.wrapping_sub(1))
+                .copied()
+                .filter(|_| back <= usize::from(self.thrown.before_len))
+        };
+        let [sync, _] = telemetry::Imu::HEADER;
+        Stream::ALL.iter().any(|outer| {
+            // The outer frame less its first byte ends where the candidate ends.
+            let back = Kind::Telemetry(*outer)
+                .len()
+                .saturating_sub(1)
+                .saturating_sub(len);
+            *outer != own
+                && back > 0
+                && before(back).and_then(stream_of_second) == Some(*outer)
+                && before(back.saturating_add(1)) != Some(sync)
+                && matches!(self.counts.rel(*outer, seq, 0), Rel::Continues | Rel::Near)
+        })
+    }
+
+    /// Whether the telemetry `frame` at the front of the window has a near count.
+    pub(super) fn near(&self, frame: &Downlink) -> bool {
+        match (frame.kind(), frame.seq()) {
+            (Kind::Telemetry(stream), Some(seq)) => self.counts.rel(stream, seq, 0) == Rel::Near,
+            _ => false,
+        }
+    }
+
+    /// Whether `seq` would continue (or be near) a stream other than `stream`; not counting, for
+    /// a candidate right after a frame rejected on a boundary, that frame's stream: the count
+    /// fits the slot of that damaged frame (one counter shared by all streams, a time tick),
+    /// which is no evidence against the frame after it.
+    pub(super) fn other_stream_fits(&self, stream: Stream, seq: u8, at: usize) -> bool {
+        let explained = match self.thrown.rejected {
+            Some(Kind::Telemetry(rejected))
+                if at == 0 && (1..=3).contains(&self.thrown.rejected_left) =>
+            {
+                Some(rejected)
+            }
+            _ => None,
+        };
+        Stream::ALL.iter().any(|other| {
+            *other != stream
+                && Some(*other) != explained
+                && matches!(self.counts.rel(*other, seq, at), Rel::Continues | Rel::Near)
+        })
+    }
+
+    /// Where the candidate at the front of the window starts, as the rules see it.
+    pub(super) fn start(&self) -> Start {
+        match self.lock {
+            Lock::Locked if self.resynced => Start::Resynced,
+            lock => Start::from(lock),
+        }
+    }
+}
+
+/// Whether `bytes` hold a telemetry header (a reply's value that might be a cut reply with the
+/// next frame's start in it).
+pub(super) fn holds_a_frame_start(bytes: &[u8]) -> bool {
+    bytes
+        .windows(2)
+        .any(|pair| telemetry_header(pair).is_some())
+}
+/// The stream whose telemetry header ends with `second`, if one does.
+pub(super) fn stream_of_second(second: u8) -> Option<Stream> {
+    let [sync, _] = telemetry::Imu::HEADER;
+    telemetry_header(&[sync, second])
+}
+/// The stream whose telemetry header `pair` is, if it is one.
+pub(super) fn telemetry_header(pair: &[u8]) -> Option<Stream> {
+    match pair {
+        [a, b] => match Kind::from_header(*a, *b) {
+            Some(Kind::Telemetry(stream)) => Some(stream),
+            _ => None,
+        },
+        _ => None,
+    }
+}

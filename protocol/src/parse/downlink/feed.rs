@@ -1,0 +1,114 @@
+//! Feeding bytes in: what `push` does past its fast path (judging the window as each byte
+//! completes what was missing), and the loop that judges the candidate at the front of the
+//! window until it needs more bytes.
+
+use super::DownlinkParser;
+use super::judge::Verdict;
+use crate::telemetry::{Downlink, Kind};
+
+impl DownlinkParser {
+    /// [`push`](Self::push) when a decision may fall: a frame's last byte and junk with nothing
+    /// before it take short ways here, a frame's first two bytes in
+    /// [`push_decide`](Self::push_decide); anything else goes through
+    /// [`push_general`](Self::push_general).
+    #[inline(never)]
+    pub(super) fn push_slow(&mut self, byte: u8) -> Option<Downlink> {
+        if !self.drain {
+            if self.missing == 1 {
+                // This byte completes the frame at the front of the window.
+                if self.buf.push(byte) {
+                    return self.complete();
+                }
+            } else if self.missing == 0 && self.buf.len() == 0 && !Kind::may_start(byte) {
+                // A byte that starts no frame, with nothing before it: thrown away at once
+                // (most bytes while hunting through noise: kept apart so that it costs little).
+                self.discard_run(&[byte]);
+                return None;
+            }
+        }
+        self.push_decide(byte)
+    }
+
+    /// [`push_slow`](Self::push_slow) for the bytes its short ways leave.
+    #[inline(never)]
+    pub(super) fn push_decide(&mut self, byte: u8) -> Option<Downlink> {
+        if self.missing > 1 || self.drain {
+            // The window's end is full (the general path makes room), or a frame is ready.
+        } else if self.missing == 0 {
+            // A frame's first two bytes: with the first, nothing can be decided; with the
+            // second, the header gives the length to wait for.
+            // (A byte that starts no frame went the short way.)
+            let wait = match self.buf.as_slice() {
+                [] => Some(0),
+                &[first] => Kind::from_header(first, byte).map(|kind| kind.len().saturating_sub(2)),
+                _ => None,
+            };
+            if let Some(wait) = wait {
+                if self.buf.push(byte) {
+                    self.missing = u8::try_from(wait).unwrap_or(0);
+                    return None;
+                }
+            }
+        }
+        self.push_general(byte)
+    }
+
+    /// [`push`](Self::push) through the general judgement.
+    #[inline(never)]
+    pub(super) fn push_general(&mut self, byte: u8) -> Option<Downlink> {
+        let ready = if self.drain { self.poll() } else { None };
+        self.append(&[byte]);
+        match ready {
+            Some(frame) => {
+                // (The window is not empty now: `missing` of 2 is for an empty one.)
+                self.missing = 0;
+                Some(frame)
+            }
+            None => self.poll(),
+        }
+    }
+
+    pub(super) fn run(&mut self, quiet: bool) -> Option<Downlink> {
+        self.missing = 0;
+        loop {
+            match self.judge(quiet) {
+                Verdict::NeedMore(n) => {
+                    self.wait_for(n);
+                    return None;
+                }
+                Verdict::Reject => self.reject(),
+                Verdict::Accept(frame, len, class) => {
+                    self.accept(&frame, len, class);
+                    // Another frame can be ready at once only if bytes are left.
+                    self.drain = self.buf.len() > 0;
+                    return Some(frame);
+                }
+            }
+        }
+    }
+
+    /// Nothing can be decided before `n` more bytes: until then they are only stored.
+    #[inline]
+    pub(super) fn wait_for(&mut self, n: usize) {
+        self.drain = false;
+        // Only a wait of two bytes or more is worth the shortcut: with one, the next byte is
+        // judged anyway (and a lone junk byte is dropped at once).
+        self.missing = if n > 1 {
+            u8::try_from(n).unwrap_or(u8::MAX)
+        } else {
+            0
+        };
+    }
+
+    /// Appends bytes; if the window is ever full, its first byte is rejected rather than a new
+    /// byte lost.
+    pub(super) fn append(&mut self, mut bytes: &[u8]) {
+        while !bytes.is_empty() {
+            if self.buf.is_full() {
+                self.reject();
+            }
+            let taken = self.buf.extend(bytes);
+            bytes = bytes.get(taken..).unwrap_or(&[]);
+        }
+    }
+}

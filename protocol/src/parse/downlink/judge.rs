@@ -1,0 +1,429 @@
+//! Judging the candidate at the front of the window: what the rules ([`rules::need`]) ask of
+//! it, and the chain of frames after it that may vouch for it ([`Walk`]).
+
+use super::class::stream_of_second;
+use super::counts::{Counts, Rel};
+use super::rules::{self, Chain, Class, Need};
+use super::{DownlinkParser, IN_STEP, Lock, MAX_GAP, WINDOW};
+use crate::telemetry::{self, Downlink, Kind, Stream};
+use core::ops::ControlFlow::{self, Break, Continue};
+
+/// What the bytes in the window say about the candidate at its front.
+pub(super) enum Verdict {
+    /// Not enough bytes to decide: at least this many more (1 or more) before a decision can
+    /// fall (a quiet line aside).
+    NeedMore(usize),
+    /// The first byte starts no frame: drop it.
+    Reject,
+    /// A frame of this length, and what it was judged to be.
+    Accept(Downlink, usize, Class),
+}
+
+/// What a step of the walk decided: `Break` with the chain's answer (`Err(n)`: not before `n`
+/// more bytes), or `Continue`.
+type Step<T = ()> = ControlFlow<Result<bool, usize>, T>;
+
+/// A walk along the frames right after a candidate, link by link, until one vouches for it
+/// (or proves it false, or more bytes are needed): what [`DownlinkParser::chain`] keeps from
+/// one link to the next.
+struct Walk<'a> {
+    parser: &'a DownlinkParser,
+    buf: &'a [u8],
+    class: Class,
+    chain: Chain,
+    quiet: bool,
+    /// The counts as the chain so far leaves them (the candidate's own taken).
+    counts: Counts,
+    /// The candidate's stream, if it is telemetry.
+    own: Option<Stream>,
+    /// Whether a quiet line right after the candidate vouches for it.
+    quiet_vouches: bool,
+    /// Where the next frame should start, and how many junk bytes may come first.
+    pos: usize,
+    gap: usize,
+    /// (Own, Restart with no step learnt) the step between the own stream's frames seen, and
+    /// how many times.
+    own_step: Option<(u8, u8)>,
+    /// (Exact) a frame of the chain already passed over.
+    skipped: bool,
+}
+
+impl<'a> Walk<'a> {
+    /// The walk after the candidate `frame` (`len` bytes at the front of `buf`).
+    fn new(
+        parser: &'a DownlinkParser,
+        buf: &'a [u8],
+        frame: &Downlink,
+        len: usize,
+        (class, chain): (Class, Chain),
+        quiet: bool,
+    ) -> Self {
+        let mut counts = parser.counts;
+        let own = match (frame.kind(), frame.seq()) {
+            (Kind::Telemetry(stream), Some(seq)) => {
+                counts.take(stream, seq, false);
+                Some(stream)
+            }
+            _ => None,
+        };
+        // A quiet line right after the candidate: it filled the burst from one quiet line to
+        // the next (Tentative), or its own count already continues.
+        let quiet_vouches = match chain {
+            // A reply nobody awaits that fills the line from a boundary up to the quiet line.
+            Chain::Exact => parser.lock != Lock::Hunting,
+            Chain::Own | Chain::Restart => false,
+            // A far count on a boundary that fills the line up to the quiet.
+            Chain::Rebase => parser.lock != Lock::Hunting,
+            // Hunting, a quiet line vouches only for the awaited reply and a count that
+            // continues exactly and fits no other stream, outside a frame rejected on a
+            // boundary: a false frame in a damaged frame's tail ends exactly where the line goes
+            // quiet, on that frame's count byte.
+            Chain::Verify => {
+                parser.lock == Lock::Tentative
+                    || matches!(class, Class::Expected { .. } | Class::Continues)
+            }
+        };
+        let gap = if class == Class::Continues {
+            MAX_GAP
+        } else {
+            0
+        };
+        Walk {
+            parser,
+            buf,
+            class,
+            chain,
+            quiet,
+            counts,
+            own,
+            quiet_vouches,
+            pos: len,
+            gap,
+            own_step: None,
+            skipped: false,
+        }
+    }
+
+    /// The next frame's header: right at `pos`, or (first link of an exactly continuing
+    /// candidate) after up to two junk bytes. `Continue` with where it starts and its kind.
+    fn next_header(&self) -> Step<(usize, Kind)> {
+        let (buf, pos, quiet) = (self.buf, self.pos, self.quiet);
+        for at in pos..=pos.saturating_add(self.gap) {
+            match (buf.get(at), buf.get(at.saturating_add(1))) {
+                (Some(a), Some(b)) => {
+                    if let Some(kind) = Kind::from_header(*a, *b) {
+                        return Continue((at, kind));
+                    }
+                }
+                (None, _) if at == pos && quiet => return Break(Ok(self.quiet_vouches)),
+                (Some(a), None) if Kind::may_start(*a) && !quiet => {
+                    return Break(undecided(buf, 1));
+                }
+                // Nothing after the candidate yet: the next header is two bytes. Its first
+                // alone allows one decision (not a header: reject), and taking it a byte later,
+                // with the second, decides the same (a reply nobody awaits is judged once less).
+                (None, _) if !quiet => {
+                    return Break(undecided(buf, if at == pos { 2 } else { 1 }));
+                }
+                _ => {}
+            }
+        }
+        Break(self.no_header())
+    }
+
+    /// No header where the next frame should start. A reply nobody awaits, on a certain
+    /// boundary, whose next frame lost its first byte: the frame after that one decides. Unless
+    /// the reply's last byte is that first byte (`FF`): the next frame's header is then whole,
+    /// a byte early, and it is the reply that lost a byte.
+    fn no_header(&self) -> Result<bool, usize> {
+        let (buf, pos) = (self.buf, self.pos);
+        let [sync, _] = telemetry::Imu::HEADER;
+        let lost_first = buf
+            .get(pos)
+            .and_then(|second| stream_of_second(*second))
+            .filter(|_| buf.get(pos.wrapping_sub(1)) != Some(&sync));
+        match lost_first {
+            Some(stream) if self.chain == Chain::Exact && !self.skipped => {
+                let next = pos
+                    .saturating_sub(1)
+                    .saturating_add(Kind::Telemetry(stream).len());
+                self.parser
+                    .past_a_damaged_frame(buf, &self.counts, stream, &[next], self.quiet)
+            }
+            _ => Ok(false),
+        }
+    }
+
+    /// The link whose header is at `at`: read whole, then judged by the chain's kind.
+    fn link(&mut self, at: usize, kind: Kind) -> Step {
+        let (buf, pos) = (self.buf, self.pos);
+        // Junk between the candidate and its chain that is the tail of a frame from the
+        // boundary before the candidate, which lost or gained a byte: the chain vouches for
+        // that frame, not for the candidate inside it.
+        if at > pos && self.parser.a_damaged_frame_ends_at(at) {
+            return Break(Ok(false));
+        }
+        let end = at.saturating_add(kind.len());
+        let Some(bytes) = buf.get(at..end) else {
+            return Break(if self.quiet || end > WINDOW {
+                Ok(false)
+            } else {
+                Err(end.saturating_sub(buf.len()))
+            });
+        };
+        let Some(next) = Downlink::read(kind, bytes) else {
+            return Break(Ok(false));
+        };
+        // The master asked once: an awaited reply whose chain holds another reply with the same
+        // code is not the answer (a `23` and the code in a damaged frame's tail, the real reply
+        // further on).
+        if matches!(self.class, Class::Expected { .. })
+            && matches!(next, Downlink::Reply(reply) if self.parser.expect == Some(reply.code))
+        {
+            return Break(Ok(false));
+        }
+        if self.chain == Chain::Exact {
+            self.exact_link(&next, at, end)?;
+            self.skipped = true;
+        } else {
+            self.counted_link(&next, at)?;
+        }
+        self.pos = end;
+        self.gap = 0;
+        Continue(())
+    }
+
+    /// (Exact) Only the next frame, continuing exactly; a stream's first frame (no count to
+    /// judge by) is passed over, a reply is not.
+    fn exact_link(&mut self, next: &Downlink, at: usize, end: usize) -> Step {
+        let (Kind::Telemetry(stream), Some(seq)) = (next.kind(), next.seq()) else {
+            return Break(Ok(false));
+        };
+        match self.counts.rel(stream, seq, at) {
+            Rel::Continues => Break(Ok(true)),
+            // On a certain boundary, frames lost upstream.
+            Rel::Near => Break(Ok(self.parser.lock == Lock::Locked)),
+            Rel::Unknown => {
+                self.counts.take(stream, seq, false);
+                Continue(())
+            }
+            // The next frame damaged (its count byte lost or changed): the frame after it
+            // decides.
+            Rel::Far if !self.skipped => {
+                let places = [end.saturating_sub(1), end.saturating_add(1)];
+                Break(self.parser.past_a_damaged_frame(
+                    self.buf,
+                    &self.counts,
+                    stream,
+                    &places,
+                    self.quiet,
+                ))
+            }
+            Rel::Far => Break(Ok(false)),
+        }
+    }
+
+    /// (Verify, Rebase, Own, Restart) A link judged by its count: one that continues (or is
+    /// near) its stream's vouches, if the chain lets its stream vouch.
+    fn counted_link(&mut self, next: &Downlink, at: usize) -> Step {
+        let (Kind::Telemetry(stream), Some(seq)) = (next.kind(), next.seq()) else {
+            return Continue(());
+        };
+        if self.own == Some(stream) && self.counts.too_soon(stream, at) {
+            return Break(Ok(false));
+        }
+        // A frame whose count byte is the second byte of a telemetry header (its last two
+        // bytes are one: a cut frame running into the next one, row 15) is no evidence: passed
+        // over.
+        if self.parser.ends_with_a_header(next, at) {
+            self.counts.take(stream, seq, false);
+            return Continue(());
+        }
+        let vouches = self.may_vouch(stream, seq)?;
+        match self.counts.rel(stream, seq, at) {
+            Rel::Continues if vouches => Break(Ok(true)),
+            Rel::Near if vouches => Break(Ok(self.chain != Chain::Exact)),
+            Rel::Continues | Rel::Near | Rel::Unknown => {
+                self.counts.take(stream, seq, false);
+                Continue(())
+            }
+            Rel::Far if matches!(self.chain, Chain::Rebase | Chain::Restart) => {
+                self.counts.take(stream, seq, false);
+                Continue(())
+            }
+            Rel::Far => Break(Ok(false)),
+        }
+    }
+
+    /// Whether a link of `stream` (count `seq`) may vouch: any stream's, but only the
+    /// candidate's own in an Own or Restart chain, and there, with no step learnt, only after
+    /// [`IN_STEP`] frames equally spaced (sensor bytes drift slowly, and payloads repeat a
+    /// frame's length apart, so false frames' "counts" can move in small steps for a while).
+    fn may_vouch(&mut self, stream: Stream, seq: u8) -> Step<bool> {
+        let own_only = matches!(self.chain, Chain::Own | Chain::Restart);
+        let vouches = !own_only || self.own == Some(stream);
+        let in_step = self.chain == Chain::Restart || !self.counts.has_steps(stream);
+        if !(vouches && own_only && in_step) {
+            return Continue(vouches);
+        }
+        let delta = seq.wrapping_sub(self.counts.last(stream));
+        match self.own_step {
+            Some((step, seen)) if step == delta && seen >= IN_STEP - 1 => Continue(true),
+            Some((step, seen)) if step == delta => {
+                self.own_step = Some((step, seen.saturating_add(1)));
+                Continue(false)
+            }
+            Some(_) => Break(Ok(false)),
+            None => {
+                self.own_step = Some((delta, 1));
+                Continue(false)
+            }
+        }
+    }
+}
+
+impl DownlinkParser {
+    /// Whether the chain of frames after the candidate (`frame`, `len` bytes) vouches for it;
+    /// `Err(n)`: not decided yet, and not before `n` more bytes (a frame of the chain is
+    /// incomplete: nothing is judged until its last byte).
+    pub(super) fn chain(
+        &self,
+        buf: &[u8],
+        frame: &Downlink,
+        len: usize,
+        rule: (Class, Chain),
+        quiet: bool,
+    ) -> Result<bool, usize> {
+        let mut walk = Walk::new(self, buf, frame, len, rule, quiet);
+        loop {
+            let step = match walk.next_header() {
+                Continue((at, kind)) => walk.link(at, kind),
+                Break(answer) => Break(answer),
+            };
+            if let Break(answer) = step {
+                return answer;
+            }
+        }
+    }
+
+    /// Judges the candidate at the front of the window. `quiet`: the line has gone quiet, so
+    /// no more bytes are coming for now.
+    pub(super) fn judge(&self, quiet: bool) -> Verdict {
+        let buf = self.buf.as_slice();
+        let (first, second) = match buf {
+            [] => return Verdict::NeedMore(1),
+            [first] if Kind::may_start(*first) && !quiet => return Verdict::NeedMore(1),
+            [_] => return Verdict::Reject,
+            [first, second, ..] => (*first, *second),
+        };
+        let Some(kind) = Kind::from_header(first, second) else {
+            return Verdict::Reject;
+        };
+        let len = kind.len();
+        let Some(bytes) = buf.get(..len) else {
+            return if quiet {
+                Verdict::Reject
+            } else {
+                Verdict::NeedMore(len.saturating_sub(buf.len()))
+            };
+        };
+        let Some(frame) = Downlink::read(kind, bytes) else {
+            return Verdict::Reject;
+        };
+        let class = self.class(&frame, 0);
+        let taken = match rules::need(self.start(), class) {
+            Need::Now => Ok(true),
+            Need::Never => Ok(false),
+            Need::Follow => followed(buf, len, quiet).ok_or(1),
+            Need::Chain(chain) => self.chain(buf, &frame, len, (class, chain), quiet),
+        };
+        match taken {
+            Ok(true) => Verdict::Accept(frame, len, class),
+            Ok(false) => Verdict::Reject,
+            Err(more) => Verdict::NeedMore(more.max(1)),
+        }
+    }
+
+    /// Whether a telemetry frame that started on the boundary right before the bytes thrown away
+    /// ahead of the window (one to three of them, the first `FF`) and lost or gained a byte
+    /// would end `at` bytes into the window.
+    pub(super) fn a_damaged_frame_ends_at(&self, at: usize) -> bool {
+        let thrown = usize::from(self.thrown.before_len);
+        let [sync, _] = telemetry::Imu::HEADER;
+        let first = self
+            .thrown
+            .before
+            .to_le_bytes()
+            .get(thrown.wrapping_sub(1))
+            .copied();
+        if !(1..=3).contains(&thrown) || first != Some(sync) {
+            return false;
+        }
+        let span = thrown.saturating_add(at);
+        [Stream::Imu, Stream::Encoders, Stream::Battery]
+            .into_iter()
+            .map(|stream| Kind::Telemetry(stream).len())
+            .any(|len| span.saturating_add(1) == len || span == len.saturating_add(1))
+    }
+
+    /// For a reply nobody awaits on a certain boundary (row 11) whose next frame is damaged:
+    /// whether a frame right after that one, at one of `places` (where it starts if the damaged
+    /// frame lost its header's first byte, or lost or gained a byte inside), continues its
+    /// stream's count.
+    #[inline(never)]
+    pub(super) fn past_a_damaged_frame(
+        &self,
+        buf: &[u8],
+        counts: &Counts,
+        damaged: Stream,
+        places: &[usize],
+        quiet: bool,
+    ) -> Result<bool, usize> {
+        if self.lock != Lock::Locked {
+            return Ok(false);
+        }
+        let mut counts = *counts;
+        counts.passed(damaged);
+        for &at in places {
+            let next = match (buf.get(at), buf.get(at.saturating_add(1))) {
+                (Some(a), Some(b)) => Kind::from_header(*a, *b),
+                _ if quiet => return Ok(false),
+                _ => return undecided(buf, at.saturating_add(2).saturating_sub(buf.len())),
+            };
+            let Some(Kind::Telemetry(stream)) = next else {
+                continue;
+            };
+            let end = at.saturating_add(Kind::Telemetry(stream).len());
+            let Some(seq) = buf.get(at.saturating_add(stream.seq_at())) else {
+                return if quiet || end > WINDOW {
+                    Ok(false)
+                } else {
+                    Err(end.saturating_sub(buf.len()))
+                };
+            };
+            if counts.rel(stream, *seq, at) == Rel::Continues {
+                return Ok(true);
+            }
+        }
+        Ok(false)
+    }
+}
+
+/// Not decided: `more` bytes are needed, unless the window is already full.
+fn undecided(buf: &[u8], more: usize) -> Result<bool, usize> {
+    if buf.len() >= WINDOW {
+        Ok(false)
+    } else {
+        Err(more)
+    }
+}
+/// Whether a header (or the quiet line) follows the `len` bytes of the candidate.
+fn followed(buf: &[u8], len: usize, quiet: bool) -> Option<bool> {
+    match buf.get(len..) {
+        Some([next, after, ..]) => Some(Kind::from_header(*next, *after).is_some()),
+        Some([next]) if !Kind::may_start(*next) => Some(false),
+        Some([]) | None if quiet => Some(true),
+        _ if quiet => Some(false),
+        _ => None,
+    }
+}
