@@ -285,3 +285,44 @@ fn a_frame_never_spans_a_quiet_line() {
     told.quiet();
     assert_eq!(told.frames(&whole).count(), 1);
 }
+
+/// The worked examples of `docs/protocol-v1.md` that no other test holds, byte for byte as the
+/// page gives them (each BCC worked out there).
+#[test]
+fn golden_frames_of_the_protocol_page() {
+    // `0x26`: motors 200, -200, 200, -200: BCC 5B.
+    assert_eq!(
+        Command::MotorVelocity(MotorVelocity::new([200, -200, 200, -200])).encode(),
+        [
+            0x7B, 0x26, 0x02, 0x04, 0x00, 0xC8, 0xFF, 0x38, 0x00, 0xC8, 0xFF, 0x38, 0x5B, 0x7D
+        ]
+    );
+    // `0x40`: the vendor's gains 3000, 1050, 0, 3000, 1050: BCC 3B.
+    assert_eq!(
+        Command::Pid(Pid {
+            position_kp: 3000,
+            position_ki: 1050,
+            position_kd: 0,
+            velocity_kp: 3000,
+            velocity_ki: 1050,
+        })
+        .encode(),
+        [
+            0x7B, 0x40, 0x0B, 0xB8, 0x04, 0x1A, 0x00, 0x00, 0x0B, 0xB8, 0x04, 0x1A, 0x3B, 0x7D
+        ]
+    );
+    // The reply to `0x36`: control mode 2, type 4, motors 120, -118, 121, -119: BCC 49.
+    let reply = [
+        0x7B, 0x36, 0x02, 0x04, 0x00, 0x78, 0xFF, 0x8A, 0x00, 0x79, 0xFF, 0x89, 0x49, 0x7D,
+    ];
+    let decoded = Reply::decode(&reply).expect("the page's reply decodes");
+    assert_eq!(
+        decoded.motor_speeds(),
+        Some(MotorVelocity {
+            ctl: 2,
+            kind: 4,
+            speeds: [120, -118, 121, -119],
+        })
+    );
+    assert_eq!(decoded.encode(), reply);
+}
