@@ -11,7 +11,9 @@ boards to try it all without hardware.
 1200
 
 Leaving a ``with`` block, an exception, ``KeyboardInterrupt``, ``close()``, the object being
-collected or the interpreter exiting stops the chassis.
+collected or the interpreter exiting stops the chassis; so do SIGTERM and SIGHUP, before the
+program's own handler runs or the process ends by the signal (see ``open``). A chassis inherited
+by a child process (a fork) is inert there.
 """
 
 from __future__ import annotations
@@ -148,6 +150,13 @@ def open(
     (v1.0.0), with the host defaults (a 200 ms failsafe; at least 300 ms on v1.0.0) changed by
     the keyword arguments, and its pump thread running: the failsafe and the telemetry run
     whatever the program does.
+
+    ``failsafe_ms`` is 50 to 5000, ``read_tries`` 2 to 10, ``idle_ms`` 1 to 500 and
+    ``board_latency_ms`` 0 to 2000: anything else is a ``ValueError``, before the port is opened.
+
+    The first ``open()`` puts a handler in front of what SIGTERM and SIGHUP do (an ignored one
+    stays ignored): every open chassis is stopped at once, on a thread of the package's own,
+    then the program's own handler runs, or, if it has none, the process ends by the signal.
 
     Raises :class:`TimeoutError` when nothing came from the board, :class:`TransportError`
     when the port cannot be opened, :class:`ChassisError` on bytes of neither firmware.

@@ -69,7 +69,7 @@ pub fn decode_capture(
     uplink: bool,
     master: Option<pyo3::pybacked::PyBackedBytes>,
     firmware: Option<&str>,
-    quiet_ms: Option<f64>,
+    quiet_ms: Option<crate::args::Real>,
 ) -> PyResult<Decoded> {
     let input = input_of(input)?;
     let firmware = match firmware {
@@ -82,14 +82,14 @@ pub fn decode_capture(
             )));
         }
     };
-    if let Some(q) = quiet_ms {
-        if !(q > 0.0 && q <= 60_000.0) {
+    if let Some(q) = &quiet_ms {
+        if !(q.value > 0.0 && q.value <= 60_000.0) {
             return Err(PyValueError::new_err(format!(
-                "quiet_ms={q} is out of range (above 0, up to 60000)"
+                "quiet_ms = {q} is out of range (above 0, up to 60000)"
             )));
         }
     }
-    let quiet_s = quiet_ms.map(|q| q / 1000.0);
+    let quiet_s = quiet_ms.map(|q| q.value / 1000.0);
     let decoded = crate::detach(py, || -> Result<decode::Decoded, String> {
         let mut capture = decode::read_capture(&data, input)?;
         capture.quiet_s = quiet_s;

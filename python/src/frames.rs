@@ -1,6 +1,7 @@
 //! The frames of both generations as Python classes: fields, `==`, `repr`, `encode() -> bytes`,
 //! `decode(bytes)`. Every class wraps the crate's own type: no frame is laid out twice.
 
+use crate::args::Int;
 use crate::errors::FrameError;
 use chassis_protocol as p;
 use chassis_protocol::v1;
@@ -13,6 +14,9 @@ fn bad(e: impl core::fmt::Display) -> PyErr {
 }
 
 // ----- 2020: master → board -----
+
+/// A 2020 speed's range: 16 bits and a direction bit.
+const SPEED: std::ops::RangeInclusive<i128> = -65_535..=65_535;
 
 /// A body velocity (2020 firmware, mode 01): X sideways, Y forward, Z rotation, each ±65535 in
 /// the board's raw units.
@@ -33,16 +37,16 @@ pub struct Velocity {
 #[pymethods]
 impl Velocity {
     #[new]
-    #[pyo3(signature = (x = 0, y = 0, z = 0))]
-    fn new(x: i32, y: i32, z: i32) -> PyResult<Self> {
-        for (name, v) in [("x", x), ("y", y), ("z", z)] {
-            if !(-65_535..=65_535).contains(&v) {
-                return Err(pyo3::exceptions::PyValueError::new_err(format!(
-                    "{name} = {v} is out of range (±65535)"
-                )));
-            }
-        }
-        Ok(Velocity { x, y, z })
+    #[pyo3(
+        signature = (x = Int::ZERO, y = Int::ZERO, z = Int::ZERO),
+        text_signature = "(x=0, y=0, z=0)"
+    )]
+    fn new(x: Int, y: Int, z: Int) -> PyResult<Self> {
+        Ok(Velocity {
+            x: x.within("x", SPEED)?,
+            y: y.within("y", SPEED)?,
+            z: z.within("z", SPEED)?,
+        })
     }
 
     /// The frame's 10 bytes.
@@ -63,7 +67,7 @@ impl Velocity {
 
 impl Velocity {
     /// The crate's velocity of `x`, `y`, `z`, range-checked (`ValueError`).
-    pub fn new_checked(x: i32, y: i32, z: i32) -> PyResult<p::Velocity> {
+    pub fn new_checked(x: Int, y: Int, z: Int) -> PyResult<p::Velocity> {
         Velocity::new(x, y, z).map(|v| v.inner())
     }
 
@@ -101,10 +105,19 @@ pub struct Turn {
 
 #[pymethods]
 impl Turn {
+    /// The angle in 0.1° (±65535: 16 bits and a direction bit) and the velocity while
+    /// turning (±65535 each); out of range is a `ValueError`, not clamped.
     #[new]
-    #[pyo3(signature = (deci_degrees, x = 0, y = 0))]
-    fn new(deci_degrees: i32, x: i32, y: i32) -> Self {
-        Turn { deci_degrees, x, y }
+    #[pyo3(
+        signature = (deci_degrees, x = Int::ZERO, y = Int::ZERO),
+        text_signature = "(deci_degrees, x=0, y=0)"
+    )]
+    fn new(deci_degrees: Int, x: Int, y: Int) -> PyResult<Self> {
+        Ok(Turn {
+            deci_degrees: deci_degrees.within("deci_degrees", SPEED)?,
+            x: x.within("x", SPEED)?,
+            y: y.within("y", SPEED)?,
+        })
     }
 
     /// The frame's 10 bytes.
@@ -177,6 +190,24 @@ impl Motors {
             if self.open_loop { "True" } else { "False" }
         )
     }
+}
+
+/// The ranges of the frames' fields.
+const I16: std::ops::RangeInclusive<i128> = -32_768..=32_767;
+const U16: std::ops::RangeInclusive<i128> = 0..=65_535;
+const U8: std::ops::RangeInclusive<i128> = 0..=255;
+
+/// Each of `values` in `range` (`ValueError` naming `name[i]`).
+fn each<T: TryFrom<i128> + Copy + Default, const N: usize>(
+    values: &[Int; N],
+    name: &str,
+    range: std::ops::RangeInclusive<i128>,
+) -> PyResult<[T; N]> {
+    let mut out = [T::default(); N];
+    for (i, (o, v)) in out.iter_mut().zip(values).enumerate() {
+        *o = v.within(&format!("{name}[{i}]"), range.clone())?;
+    }
+    Ok(out)
 }
 
 /// Python ints as `i64`, one too large for it a `ValueError` (out of range), not an
@@ -305,7 +336,8 @@ pub fn write_of(name: &str, value: u32) -> PyResult<p::Write> {
 #[pymethods]
 impl Write {
     #[new]
-    fn new(register: &str, value: u32) -> PyResult<Self> {
+    fn new(register: &str, value: Int) -> PyResult<Self> {
+        let value = value.within(register, 0..=i128::from(u32::MAX))?;
         write_of(register, value)?;
         Ok(Write {
             register: register.to_string(),
@@ -446,8 +478,12 @@ downlink_methods!(
     {
         #[new]
         #[pyo3(signature = (accel, gyro, seq))]
-        fn new(accel: [i16; 3], gyro: [i16; 3], seq: u8) -> Self {
-            Imu { accel, gyro, seq }
+        fn new(accel: [Int; 3], gyro: [Int; 3], seq: Int) -> PyResult<Self> {
+            Ok(Imu {
+                accel: each(&accel, "accel", I16)?,
+                gyro: each(&gyro, "gyro", I16)?,
+                seq: seq.within("seq", U8)?,
+            })
         }
     }
 );
@@ -474,8 +510,11 @@ downlink_methods!(
     |f| format!("Encoders(ticks={:?}, seq={})", f.ticks, f.seq),
     {
         #[new]
-        fn new(ticks: [i16; 4], seq: u8) -> Self {
-            Encoders { ticks, seq }
+        fn new(ticks: [Int; 4], seq: Int) -> PyResult<Self> {
+            Ok(Encoders {
+                ticks: each(&ticks, "ticks", I16)?,
+                seq: seq.within("seq", U8)?,
+            })
         }
     }
 );
@@ -507,12 +546,12 @@ downlink_methods!(
     ),
     {
         #[new]
-        fn new(centivolts: u16, percent: u16, seq: u8) -> Self {
-            Battery {
-                centivolts,
-                percent,
-                seq,
-            }
+        fn new(centivolts: Int, percent: Int, seq: Int) -> PyResult<Self> {
+            Ok(Battery {
+                centivolts: centivolts.within("centivolts", U16)?,
+                percent: percent.within("percent", U16)?,
+                seq: seq.within("seq", U8)?,
+            })
         }
     }
 );
@@ -547,8 +586,9 @@ downlink_methods!(
     {
         /// The reply to a read of `register` carrying `value`.
         #[new]
-        fn new(register: &str, value: u32) -> PyResult<Self> {
+        fn new(register: &str, value: Int) -> PyResult<Self> {
             let r = self::register(register)?;
+            let value = value.within("value", 0..=i128::from(u32::MAX))?;
             Ok(p::Reply::new(r, value).into())
         }
     }
@@ -624,8 +664,10 @@ pub struct Action {
 #[pymethods]
 impl Action {
     #[new]
-    fn new(number: u16) -> Self {
-        Action { number }
+    fn new(number: Int) -> PyResult<Self> {
+        Ok(Action {
+            number: number.within("number", U16)?,
+        })
     }
 
     /// The frame's 10 bytes.
@@ -702,15 +744,18 @@ impl From<v1::BodyVelocity> for BodyVelocity {
 #[pymethods]
 impl BodyVelocity {
     #[new]
-    #[pyo3(signature = (vx_mm_s = 0, vy_mm_s = 0, wz_mrad_s = 0, ctl = 2, kind = 4))]
-    fn new(vx_mm_s: i16, vy_mm_s: i16, wz_mrad_s: i16, ctl: u8, kind: u8) -> Self {
-        BodyVelocity {
-            vx_mm_s,
-            vy_mm_s,
-            wz_mrad_s,
-            ctl,
-            kind,
-        }
+    #[pyo3(
+        signature = (vx_mm_s = Int::ZERO, vy_mm_s = Int::ZERO, wz_mrad_s = Int::ZERO, ctl = Int::from(2), kind = Int::from(4)),
+        text_signature = "(vx_mm_s=0, vy_mm_s=0, wz_mrad_s=0, ctl=2, kind=4)"
+    )]
+    fn new(vx_mm_s: Int, vy_mm_s: Int, wz_mrad_s: Int, ctl: Int, kind: Int) -> PyResult<Self> {
+        Ok(BodyVelocity {
+            vx_mm_s: vx_mm_s.within("vx_mm_s", I16)?,
+            vy_mm_s: vy_mm_s.within("vy_mm_s", I16)?,
+            wz_mrad_s: wz_mrad_s.within("wz_mrad_s", I16)?,
+            ctl: ctl.within("ctl", U8)?,
+            kind: kind.within("kind", U8)?,
+        })
     }
 
     /// The forced stop.
@@ -785,23 +830,23 @@ impl From<v1::Telemetry> for Telemetry {
 impl Telemetry {
     #[new]
     #[pyo3(
-        signature = (velocity = [0; 3], accel = [0; 3], gyro = [0; 3], quaternion = [1000, 0, 0, 0], battery_mv = 0),
+        signature = (velocity = [Int::ZERO; 3], accel = [Int::ZERO; 3], gyro = [Int::ZERO; 3], quaternion = [Int::from(1000), Int::ZERO, Int::ZERO, Int::ZERO], battery_mv = Int::ZERO),
         text_signature = "(velocity=(0, 0, 0), accel=(0, 0, 0), gyro=(0, 0, 0), quaternion=(1000, 0, 0, 0), battery_mv=0)"
     )]
     fn new(
-        velocity: [i16; 3],
-        accel: [i16; 3],
-        gyro: [i16; 3],
-        quaternion: [i16; 4],
-        battery_mv: i16,
-    ) -> Self {
-        Telemetry {
-            velocity,
-            accel,
-            gyro,
-            quaternion,
-            battery_mv,
-        }
+        velocity: [Int; 3],
+        accel: [Int; 3],
+        gyro: [Int; 3],
+        quaternion: [Int; 4],
+        battery_mv: Int,
+    ) -> PyResult<Self> {
+        Ok(Telemetry {
+            velocity: each(&velocity, "velocity", I16)?,
+            accel: each(&accel, "accel", I16)?,
+            gyro: each(&gyro, "gyro", I16)?,
+            quaternion: each(&quaternion, "quaternion", I16)?,
+            battery_mv: battery_mv.within("battery_mv", I16)?,
+        })
     }
 
     /// The heading from the quaternion, in degrees (−180…180].
@@ -877,7 +922,8 @@ impl ReadbackReply {
     /// The reply to the readback `request` (`system`, `geometry`, …) with its ten payload
     /// bytes.
     #[new]
-    fn new(request: &str, payload: [u8; 10]) -> PyResult<Self> {
+    fn new(request: &str, payload: [Int; 10]) -> PyResult<Self> {
+        let payload = each(&payload, "payload", U8)?;
         let request = v1::Readback::from_name(request).ok_or_else(|| {
             pyo3::exceptions::PyValueError::new_err(format!(
                 "{request:?} is not a readback: give one of {}",

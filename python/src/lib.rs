@@ -3,12 +3,14 @@
 //! failsafe and turn guard over a serial port (`open`, `Chassis`, `ChassisV1`), the frames and
 //! parsers of both firmware generations, and simulated boards (`chassis.sim`).
 
+mod args;
 mod capture;
 mod driver;
 mod errors;
 mod frames;
 mod json;
 mod parsers;
+mod signals;
 mod sim;
 
 use pyo3::prelude::*;

@@ -1,6 +1,7 @@
 //! The streaming parsers of both generations, for captures and for code that owns its own
 //! serial port: `feed(bytes) -> list` of frames, `quiet(ms)`, `expect_reply(register)`, `stats`.
 
+use crate::args::Int;
 use crate::frames;
 use chassis_protocol as p;
 use chassis_protocol::v1;
@@ -32,7 +33,8 @@ impl DownlinkParser {
     }
 
     /// The line has been quiet for `ms`: the frames that waited for it.
-    fn quiet(&mut self, py: Python<'_>, ms: u32) -> PyResult<Vec<Py<PyAny>>> {
+    fn quiet(&mut self, py: Python<'_>, ms: Int) -> PyResult<Vec<Py<PyAny>>> {
+        let ms: u32 = ms.within("ms", 0..=i128::from(u32::MAX))?;
         let mut out = Vec::new();
         while let Some(f) = self.inner.quiet(ms) {
             out.push(frames::downlink(py, f)?);
@@ -96,9 +98,10 @@ impl UplinkParser {
     }
 
     /// The line has been quiet: a frame cut short is thrown away.
-    fn quiet(&mut self, ms: u32) {
-        let _ = ms;
+    fn quiet(&mut self, ms: Int) -> PyResult<()> {
+        let _: u32 = ms.within("ms", 0..=i128::from(u32::MAX))?;
         self.inner.idle();
+        Ok(())
     }
 
     /// Counters: frames, bytes discarded, resyncs.

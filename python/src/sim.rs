@@ -1,6 +1,7 @@
 //! `chassis.sim`: a simulated board of either generation, in the process (`Board`) or served in
 //! real time on a pseudo-terminal (`pty()`), so that every example and test runs on a laptop.
 
+use crate::args::Int;
 use chassis_protocol::sim::{self, Simulated, serve};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
@@ -75,13 +76,25 @@ pub struct SimBoard {
     board: AnyBoard,
 }
 
+/// How far `Board.advance` moves the board's clock at once: an hour (it simulates every
+/// millisecond; an hour takes a fraction of a second, and Ctrl-C is heard meanwhile).
+const AHEAD_MS: u64 = 3_600_000;
+
+/// A seed as `Board` and `pty` take it (any 64-bit unsigned value).
+fn seed_of(seed: &Int) -> PyResult<u64> {
+    seed.within("seed", 0..=i128::from(u64::MAX))
+}
+
 #[pymethods]
 impl SimBoard {
     #[new]
-    #[pyo3(signature = (firmware = "2020", seed = 1))]
-    fn new(firmware: &str, seed: u64) -> PyResult<Self> {
+    #[pyo3(
+        signature = (firmware = "2020", seed = Int::from(1)),
+        text_signature = "(firmware=\"2020\", seed=1)"
+    )]
+    fn new(firmware: &str, seed: Int) -> PyResult<Self> {
         Ok(SimBoard {
-            board: board(firmware, seed)?,
+            board: board(firmware, seed_of(&seed)?)?,
         })
     }
 
@@ -90,9 +103,24 @@ impl SimBoard {
         self.board.receive(&data);
     }
 
-    /// Moves the board's clock to `now_ms`.
-    fn advance(&mut self, now_ms: u64) {
-        self.board.advance(now_ms);
+    /// Moves the board's clock to `now_ms` (a time already past: nothing), at most an hour
+    /// (3 600 000 ms) ahead of where it is (`ValueError` beyond); Python's signals are heard
+    /// meanwhile (Ctrl-C raises `KeyboardInterrupt`, the board left where it got to).
+    fn advance(&mut self, py: Python<'_>, now_ms: Int) -> PyResult<()> {
+        let now_ms: u64 = now_ms.within("now_ms", 0..=i128::from(u64::MAX))?;
+        let from = self.board.now_ms();
+        if now_ms.saturating_sub(from) > AHEAD_MS {
+            return Err(PyValueError::new_err(format!(
+                "now_ms = {now_ms} is more than an hour ({AHEAD_MS} ms) ahead of the board's time ({from} ms): the board is simulated a millisecond at a time, advance it an hour at a time at most"
+            )));
+        }
+        let mut at = from;
+        while at < now_ms {
+            at = now_ms.min(at.saturating_add(10_000));
+            self.board.advance(at);
+            py.check_signals()?;
+        }
+        Ok(())
     }
 
     /// What the board sent since the last call (at most 64 KiB).
@@ -157,6 +185,21 @@ pub struct SimPty {
     heard: Arc<Mutex<Vec<u8>>>,
     thread: Option<JoinHandle<()>>,
     keep: Option<serialport::TTYPort>,
+    /// The process serving it (a child made by fork leaves it alone).
+    pid: u32,
+}
+
+impl SimPty {
+    /// In a child made by fork the serving thread is not there: let go of everything without
+    /// joining or closing (the parent's board goes on). Whether this is such a child.
+    fn forked(&mut self) -> bool {
+        if std::process::id() == self.pid {
+            return false;
+        }
+        std::mem::forget(self.thread.take());
+        std::mem::forget(self.keep.take());
+        true
+    }
 }
 
 #[pymethods]
@@ -192,8 +235,11 @@ impl SimPty {
         self.silent.store(silent, Ordering::SeqCst);
     }
 
-    /// Stops serving (again: nothing).
+    /// Stops serving (again: nothing; in a child process made by fork: nothing).
     fn close(&mut self, py: Python<'_>) {
+        if self.forked() {
+            return;
+        }
         self.stop.store(true, Ordering::SeqCst);
         if let Some(t) = self.thread.take() {
             crate::detach(py, || {
@@ -226,6 +272,9 @@ impl SimPty {
 
 impl Drop for SimPty {
     fn drop(&mut self) {
+        if self.forked() {
+            return;
+        }
         self.stop.store(true, Ordering::SeqCst);
         if let Some(t) = self.thread.take() {
             let _ = t.join();
@@ -236,10 +285,13 @@ impl Drop for SimPty {
 /// Serves a simulated board (`firmware` "2020" or "v1.0.0") on a new pseudo-terminal; returns
 /// a `Pty` whose `path` a program opens as the board's serial port.
 #[pyfunction]
-#[pyo3(signature = (firmware = "2020", seed = 1))]
-pub fn pty(firmware: &str, seed: u64) -> PyResult<SimPty> {
+#[pyo3(
+    signature = (firmware = "2020", seed = Int::from(1)),
+    text_signature = "(firmware=\"2020\", seed=1)"
+)]
+pub fn pty(firmware: &str, seed: Int) -> PyResult<SimPty> {
     use serialport::SerialPort as _;
-    let board = board(firmware, seed)?;
+    let board = board(firmware, seed_of(&seed)?)?;
     let (mut board_end, path_end) = serialport::TTYPort::pair()
         .map_err(|e| PyOSError::new_err(format!("cannot make a pseudo-terminal: {e}")))?;
     board_end
@@ -260,6 +312,7 @@ pub fn pty(firmware: &str, seed: u64) -> PyResult<SimPty> {
     let thread = std::thread::Builder::new()
         .name("chassis-sim".into())
         .spawn(move || {
+            crate::signals::keep_signals_off_this_thread();
             let _ = serve(board, tap, &flag);
         })
         .map_err(|e| PyOSError::new_err(format!("cannot start the simulated board: {e}")))?;
@@ -271,5 +324,6 @@ pub fn pty(firmware: &str, seed: u64) -> PyResult<SimPty> {
         heard,
         thread: Some(thread),
         keep: Some(path_end),
+        pid: std::process::id(),
     })
 }

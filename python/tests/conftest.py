@@ -45,6 +45,26 @@ def frames_2020(data: bytes) -> list[bytes]:
     return out
 
 
+def frames_v1(data: bytes) -> list[bytes]:
+    """The board's received bytes as v1.0.0 commands (14 bytes each, `7B … 7D`, from the spec)."""
+    out = [data[at : at + 14] for at in range(0, len(data), 14)]
+    for at, f in enumerate(out):
+        assert len(f) == 14 and f[0] == 0x7B and f[13] == 0x7D, f"no frame at {14 * at}: {f.hex(' ')}"
+    return out
+
+
+# The frame that stops the chassis, per firmware.
+STOPS = {"2020": STOP, "v1.0.0": FORCED_STOP}
+
+
+def motion(data: bytes, firmware: str) -> list[bytes]:
+    """The motion frames among the board's received bytes: 2020 modes 01 (velocity, turn), 02
+    and 03 (motors); v1.0.0 codes 0x25 (body velocity, the forced stop) and 0x26 (motors)."""
+    if firmware == "2020":
+        return [f for f in frames_2020(data) if f[2] in (0x01, 0x02, 0x03)]
+    return [f for f in frames_v1(data) if f[1] in (0x25, 0x26)]
+
+
 def wait_until(what: str, condition: Callable[[], bool], seconds: float = 5.0) -> float:
     """Waits for `condition`; the time it took."""
     start = time.monotonic()
