@@ -157,25 +157,3 @@ impl Line {
         x
     }
 }
-
-impl super::Board {
-    /// Copies bytes for the master into `buf`, with the faults applied; returns how many.
-    pub fn transmit(&mut self, buf: &mut [u8]) -> usize {
-        self.line.transmit(self.now_ms, buf)
-    }
-
-    /// Whether a byte for the master has crossed the wire by now (what a UART's "data ready"
-    /// says).
-    #[must_use]
-    pub fn byte_arrived(&self) -> bool {
-        self.line.byte_arrived(self.now_ms)
-    }
-
-    pub(super) fn send(&mut self, bytes: &[u8]) {
-        self.line.send(self.now_ms, bytes);
-    }
-
-    pub(super) fn next_random(&mut self) -> u64 {
-        self.line.next_random()
-    }
-}

@@ -3,7 +3,7 @@
 //! with `v1::DownlinkParser`.
 
 use super::*;
-use crate::v1::{Downlink, DownlinkParser, Parser};
+use crate::v1::{Downlink, DownlinkParser, Parser, Telemetry};
 
 /// The vendor's readback requests, as PROTOCOL-V1.md quotes them (BCC 48, 4F, 2B).
 const READ_SYSTEM: [u8; 14] = [0x7B, 0x33, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x48, 0x7D];

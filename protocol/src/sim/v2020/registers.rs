@@ -19,18 +19,40 @@ pub const FACTORY: Snapshot = Snapshot {
     battery_cutoff_centivolts: 0x7FFF,
 };
 
+/// The registers: the live copy, the stored one, and a gyro calibration running.
+#[derive(Clone, Debug)]
+pub(super) struct Registers {
+    /// What the board works with.
+    pub(super) live: Snapshot,
+    /// What it would load back (its flash).
+    pub(super) stored: Snapshot,
+    /// A gyro calibration ends then, ms.
+    pub(super) calibrating_until_ms: Option<u64>,
+}
+
+impl Registers {
+    /// The factory defaults, live and stored.
+    pub(super) const fn new() -> Self {
+        Registers {
+            live: FACTORY,
+            stored: FACTORY,
+            calibrating_until_ms: None,
+        }
+    }
+}
+
 /// Gyro calibration time: 10 s settle + 20 s still.
 const CALIBRATION_MS: u64 = 30_000;
 impl Board {
     pub(super) fn setting(&mut self, setting: Setting) {
-        self.quiet_until_ms = self
+        self.streams.quiet_until_ms = self
             .now_ms
             .saturating_add(u64::from(self.config.resume_after_ms));
         match setting {
             Setting::Action(action) => self.action(action),
             Setting::Write(write) => {
-                let compensation_was = self.live.system_mode.gyro_compensation();
-                self.live.set(write);
+                let compensation_was = self.registers.live.system_mode.gyro_compensation();
+                self.registers.live.set(write);
                 match write {
                     Write::GyroCalibration(0xFFFF) => self.start_calibration(),
                     Write::SystemMode(mode) if mode.gyro_compensation() && !compensation_was => {
@@ -43,7 +65,7 @@ impl Board {
                 let value = match register {
                     Register::PendingAngle => self.pending_deci_degrees() as u32,
                     Register::GyroCalibration if self.calibrating() => 0xFFFF,
-                    other => self.live.value(other).unwrap_or(0),
+                    other => self.registers.live.value(other).unwrap_or(0),
                 };
                 let due = self
                     .now_ms
@@ -56,20 +78,28 @@ impl Board {
 
     pub(super) fn action(&mut self, action: Action) {
         match action {
-            Action::LoadStored => self.live = self.stored,
-            Action::LoadDefaults => self.live = FACTORY,
+            Action::LoadStored => self.registers.live = self.registers.stored,
+            Action::LoadDefaults => self.registers.live = FACTORY,
             Action::Store => {
                 // System-mode bit 3 is not stored.
-                let compensation = self.stored.system_mode.gyro_compensation();
-                self.stored = self.live;
-                self.stored.system_mode =
-                    self.stored.system_mode.with_gyro_compensation(compensation);
+                let compensation = self.registers.stored.system_mode.gyro_compensation();
+                self.registers.stored = self.registers.live;
+                self.registers.stored.system_mode = self
+                    .registers
+                    .stored
+                    .system_mode
+                    .with_gyro_compensation(compensation);
             }
             Action::GyroCompensationOff => {
-                self.live.system_mode = self.live.system_mode.with_gyro_compensation(false);
+                self.registers.live.system_mode = self
+                    .registers
+                    .live
+                    .system_mode
+                    .with_gyro_compensation(false);
             }
             Action::GyroCompensationOn | Action::RecalibrateGyro => {
-                self.live.system_mode = self.live.system_mode.with_gyro_compensation(true);
+                self.registers.live.system_mode =
+                    self.registers.live.system_mode.with_gyro_compensation(true);
                 self.start_calibration();
             }
             Action::Unknown(_) => {}
@@ -77,6 +107,6 @@ impl Board {
     }
 
     pub(super) fn start_calibration(&mut self) {
-        self.calibrating_until_ms = Some(self.now_ms.saturating_add(CALIBRATION_MS));
+        self.registers.calibrating_until_ms = Some(self.now_ms.saturating_add(CALIBRATION_MS));
     }
 }
