@@ -1,0 +1,75 @@
+//! The fuzz targets (`host-tests/fuzz`): `cargo xtask fuzz [SECONDS]` explores, `test` runs each
+//! a fixed number of times from a fixed seed.
+
+use crate::cmd::{check, host_tests, workspace_root};
+use crate::tools::{install_cargo_tool, install_nightly};
+use std::process::Command;
+
+/// The fuzz targets, in `host-tests/fuzz`, each with the number of runs `test` gives it (about
+/// 30 s each here).
+const FUZZ_TARGETS: [(&str, u32); 5] = [
+    ("downlink", 500_000),
+    ("uplink", 500_000),
+    ("roundtrip", 1_000_000),
+    ("spliced", 50_000),
+    ("v1", 500_000),
+];
+
+/// libFuzzer's seed for the runs in `test`.
+const CI_FUZZ_SEED: &str = "2026";
+
+/// How a fuzz run is driven.
+pub(crate) enum FuzzRun {
+    /// `test`: a fixed seed, a fixed number of runs per target (capped at two minutes) and
+    /// corpora generated afresh, so that every CI run goes through the same inputs: CI fails on
+    /// a change to the code, never on the luck of the draw. Exploring is `fuzz`'s job.
+    Repeatable,
+    /// `fuzz SECONDS`: a random seed, each target for SECONDS, corpora kept between runs in
+    /// `host-tests/fuzz/corpus`, so that every run explores further.
+    Explore(u32),
+}
+
+/// Runs every fuzz target, from generated seed corpora; fails on any crash.
+pub(crate) fn fuzz(run: FuzzRun) -> Result<(), String> {
+    install_nightly()?;
+    install_cargo_tool("fuzz", "cargo-fuzz", None, &[])?;
+    let root = workspace_root()?;
+    let fuzz_dir = root.join("host-tests").join("fuzz");
+    let corpus = match run {
+        FuzzRun::Repeatable => {
+            let fresh = root.join("target").join("fuzz-ci-corpus");
+            if fresh.exists() {
+                std::fs::remove_dir_all(&fresh)
+                    .map_err(|e| format!("cannot clear {}: {e}", fresh.display()))?;
+            }
+            fresh
+        }
+        FuzzRun::Explore(_) => fuzz_dir.join("corpus"),
+    };
+    let corpus_arg = corpus.to_string_lossy().into_owned();
+    host_tests("--bin", "fuzz-seeds", &[&corpus_arg])?;
+    for (target, runs) in FUZZ_TARGETS {
+        let target_corpus = corpus.join(target).to_string_lossy().into_owned();
+        let limits = match run {
+            FuzzRun::Repeatable => vec![
+                format!("-seed={CI_FUZZ_SEED}"),
+                format!("-runs={runs}"),
+                "-max_total_time=120".to_string(),
+            ],
+            FuzzRun::Explore(seconds) => vec![format!("-max_total_time={seconds}")],
+        };
+        let mut args = vec!["+nightly", "fuzz", "run", target, &target_corpus, "--"];
+        args.extend(limits.iter().map(String::as_str));
+        eprintln!("$ cargo {}", args.join(" "));
+        check(
+            Command::new("cargo").args(&args).current_dir(&fuzz_dir),
+            "cargo fuzz",
+            |status| {
+                format!(
+                    "fuzz target {target} failed ({status}): see host-tests/fuzz/artifacts/{target}"
+                )
+            },
+        )?;
+    }
+    Ok(())
+}
