@@ -107,7 +107,7 @@ pub fn detect_downlink(capture: &Capture) -> Detection {
 /// one with at least one and four times as many as the other decides.
 #[must_use]
 pub fn detect_uplink(capture: &Capture) -> Detection {
-    let found = generation::ALL.map(|(firmware, g)| (firmware, g.uplink_frames(capture)));
+    let found = generation::all().map(|(firmware, g)| (firmware, g.uplink_frames(capture)));
     let decides = |&&(firmware, frames): &&(Firmware, u32)| {
         let others = found
             .iter()

@@ -1,6 +1,6 @@
 //! The one place the decoder turns a firmware generation into the code that decodes it. Each
 //! generation's decoding is written once, behind [`Generation`] ([`crate::v2020`],
-//! [`crate::v1`]); [`ALL`] pairs each generation with its decoder, and nothing else in the crate
+//! [`crate::v1`]); [`of`] picks each generation's decoder, and nothing else in the crate
 //! asks which generation a capture holds.
 
 use crate::found::Side;
@@ -26,19 +26,20 @@ pub(crate) trait Generation: Sync {
     fn uplink_frames(&self, capture: &Capture) -> u32;
 }
 
-/// Every generation, each with what decodes it: 2020 first, then v1.0.0, the order in which
-/// [`crate::Detection::NotRecognised`] counts their frames.
-pub(crate) const ALL: [(Firmware, &dyn Generation); 2] = [
-    (Firmware::V2020, &crate::v2020::V2020),
-    (Firmware::V1_0_0, &crate::v1::V1),
-];
+/// Every generation, each with what decodes it, in [`Firmware::ALL`]'s order (2020 first,
+/// then v1.0.0): the order in which [`crate::Detection::NotRecognised`] counts their frames.
+pub(crate) fn all() -> [(Firmware, &'static dyn Generation); Firmware::ALL.len()] {
+    Firmware::ALL.map(|firmware| (firmware, of(firmware)))
+}
 
 /// The generation a capture is decoded as when nothing decides (2020).
-pub(crate) const UNDECIDED: Firmware = ALL[0].0;
+pub(crate) const UNDECIDED: Firmware = Firmware::ALL[0];
 
-/// What decodes a capture of `firmware`.
+/// What decodes a capture of `firmware` (exhaustive: a third generation does not build
+/// until it has a decoder).
 pub(crate) fn of(firmware: Firmware) -> &'static dyn Generation {
-    ALL.iter()
-        .find(|(f, _)| *f == firmware)
-        .map_or(ALL[0].1, |(_, g)| *g)
+    match firmware {
+        Firmware::V2020 => &crate::v2020::V2020,
+        Firmware::V1_0_0 => &crate::v1::V1,
+    }
 }

@@ -37,6 +37,9 @@ pub enum Firmware {
 }
 
 impl Firmware {
+    /// Every generation, oldest first.
+    pub const ALL: [Firmware; 2] = [Firmware::V2020, Firmware::V1_0_0];
+
     /// Its name as owners know it: `2020` or `v1.0.0`.
     #[must_use]
     pub const fn name(self) -> &'static str {
