@@ -8,7 +8,7 @@
 //! within [`EXIT_BOUND`] of the ending, with the ending's exit status and a message that says
 //! what happened. The table (command × ending: runs, moved, stopped, exit statuses, the worst
 //! time to stop and to exit, at which moment) is printed, and written to
-//! `target/attack-table.md`.
+//! `target/attack-table.md`; every run's row to `target/attack-runs.md`.
 
 mod harness;
 
@@ -504,6 +504,35 @@ fn table(outcomes: &[Outcome]) -> String {
     text
 }
 
+/// Every run, a row each: command × ending × moment → moved, stopped, exit status, time to
+/// stop and to exit.
+fn runs(outcomes: &[Outcome]) -> String {
+    let mut sorted: Vec<&Outcome> = outcomes.iter().collect();
+    sorted.sort_by_key(|o| (o.case, o.ending, o.moment_ms));
+    let mut text = String::from(
+        "| firmware | command | ending | moment | moved | stopped | exit status | time to stop | time to exit |\n|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for o in sorted {
+        let case = CASES[o.case];
+        text.push_str(&format!(
+            "| {} | {} | {} | {} ms | {} | {} | {} | {} | {} ms |\n",
+            match case.generation {
+                Generation::V2020 => "2020",
+                Generation::V1 => "v1.0.0",
+            },
+            case.name,
+            o.ending.name(),
+            o.moment_ms,
+            if o.moved { "yes" } else { "no" },
+            if o.stopped { "yes" } else { "no" },
+            o.exit,
+            o.to_stop_ms.map_or("-".into(), |ms| format!("{ms} ms")),
+            o.to_exit_ms,
+        ));
+    }
+    text
+}
+
 #[test]
 fn every_ending_of_every_command_stops_the_chassis() {
     let dir = std::env::temp_dir().join(format!("chassis-attack-{}", std::process::id()));
@@ -556,9 +585,9 @@ fn every_ending_of_every_command_stops_the_chassis() {
     println!("{summary}");
     let target = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("..")
-        .join("target")
-        .join("attack-table.md");
-    let _ = std::fs::write(&target, &summary);
+        .join("target");
+    let _ = std::fs::write(target.join("attack-table.md"), &summary);
+    let _ = std::fs::write(target.join("attack-runs.md"), runs(&outcomes));
     let _ = std::fs::remove_dir_all(&dir);
     let problems: Vec<String> = outcomes
         .iter()
