@@ -217,11 +217,7 @@ extern "C" fn handler(signal: libc::c_int, info: *mut libc::siginfo_t, context: 
         }
         // The chassis stopped (`again`), or a child made by fork (the chassis are the
         // parent's): the signal does what it did before this package.
-        let previous = PREVIOUS
-            .get(index)
-            .map(|p| p.load(Ordering::Acquire))
-            .and_then(|p| p.as_ref());
-        if let Some(previous) = previous {
+        if let Some(previous) = previous(index) {
             match previous.sa_sigaction {
                 libc::SIG_DFL => {
                     libc::signal(signal, libc::SIG_DFL);
@@ -257,8 +253,27 @@ fn watch(read_fd: libc::c_int) {
     }
 }
 
+/// What signal `index` of [`SIGNALS`] did before this package's handler, if the handler is
+/// installed.
+fn previous(index: usize) -> Option<&'static libc::sigaction> {
+    let previous = PREVIOUS.get(index)?.load(Ordering::Acquire);
+    // SAFETY: a previous action, once stored, is never freed.
+    unsafe { previous.as_ref() }
+}
+
+/// The chassis this process opened that are still open.
+fn open_chassis(guard: &Guard) -> Vec<Arc<dyn Stoppable>> {
+    guard
+        .chassis
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+        .iter()
+        .filter_map(Weak::upgrade)
+        .collect()
+}
+
 /// A signal came: every chassis of this process stopped; then, if the signal's action is the
-/// default one, the process ended by it.
+/// default one, the process ended by it, else the signal passed on to the program's handler.
 fn on_signal(index: usize) {
     let Some(&(signal, name)) = SIGNALS.get(index) else {
         return;
@@ -267,19 +282,8 @@ fn on_signal(index: usize) {
     let Some(guard) = (unsafe { GUARD.load(Ordering::Acquire).as_ref() }) else {
         return;
     };
-    let previous = PREVIOUS
-        .get(index)
-        .map(|p| p.load(Ordering::Acquire))
-        // SAFETY: a previous action, once stored, is never freed.
-        .and_then(|p| unsafe { p.as_ref() });
-    let ends = previous.is_some_and(|p| p.sa_sigaction == libc::SIG_DFL);
-    let chassis: Vec<Arc<dyn Stoppable>> = guard
-        .chassis
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner)
-        .iter()
-        .filter_map(Weak::upgrade)
-        .collect();
+    let ends = previous(index).is_some_and(|p| p.sa_sigaction == libc::SIG_DFL);
+    let chassis = open_chassis(guard);
     // Every stop frame first; then the program's handler; then the cancels of turns, all within
     // one bound.
     let sent: Vec<_> = chassis
@@ -295,6 +299,18 @@ fn on_signal(index: usize) {
             }
         }
     }
+    let said = settle(&chassis, sent);
+    if ends {
+        end_process(signal, name, &said);
+    }
+}
+
+/// Waits (within one bound) for what each stop started (2020: the cancel of a turn); what
+/// happened to each chassis, in words.
+fn settle(
+    chassis: &[Arc<dyn Stoppable>],
+    sent: Vec<Result<Option<u64>, StopFailed>>,
+) -> Vec<String> {
     let until = Instant::now() + crate::driver::STOP_WAIT;
     let mut said = Vec::new();
     for (c, sent) in chassis.iter().zip(sent) {
@@ -312,9 +328,12 @@ fn on_signal(index: usize) {
             )),
         }
     }
-    if !ends {
-        return;
-    }
+    said
+}
+
+/// Ends the process by `signal` (its default action), after one line to standard error that
+/// says what became of each chassis (`said`).
+fn end_process(signal: libc::c_int, name: &str, said: &[String]) {
     let said = if said.is_empty() {
         "no chassis open".to_string()
     } else {
