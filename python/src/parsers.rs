@@ -28,8 +28,7 @@ impl DownlinkParser {
 
     /// Takes bytes; the frames they complete, in order (`Imu`, `Encoders`, `Battery`, `Reply`).
     fn feed(&mut self, py: Python<'_>, data: PyBackedBytes) -> PyResult<Vec<Py<PyAny>>> {
-        let found: Vec<p::Downlink> = crate::detach(py, || self.inner.frames(&data).collect());
-        found.into_iter().map(|f| frames::downlink(py, f)).collect()
+        found(py, || self.inner.frames(&data).collect(), frames::downlink)
     }
 
     /// The line has been quiet for `ms`: the frames that waited for it.
@@ -93,8 +92,7 @@ impl UplinkParser {
     /// Takes bytes; the commands they complete (`Velocity`, `Turn`, `Motors`, `Read`, `Write`,
     /// `Action`).
     fn feed(&mut self, py: Python<'_>, data: PyBackedBytes) -> PyResult<Vec<Py<PyAny>>> {
-        let found: Vec<p::Command> = crate::detach(py, || self.inner.frames(&data).collect());
-        found.into_iter().map(|f| frames::uplink(py, f)).collect()
+        found(py, || self.inner.frames(&data).collect(), frames::uplink)
     }
 
     /// The line has been quiet: a frame cut short is thrown away.
@@ -108,99 +106,97 @@ impl UplinkParser {
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = self.inner.stats();
-        let d = PyDict::new(py);
-        d.set_item("frames", s.frames)?;
-        d.set_item("discarded", s.discarded)?;
-        d.set_item("resyncs", s.resyncs)?;
-        Ok(d)
+        counts(
+            py,
+            &[
+                ("frames", s.frames),
+                ("discarded", s.discarded),
+                ("resyncs", s.resyncs),
+            ],
+        )
     }
 }
 
-/// v1.0.0 parser counters as a dict.
-fn v1_stats<'py>(py: Python<'py>, s: v1::Stats) -> PyResult<Bound<'py, PyDict>> {
+/// Counters by name as a dict (in their order).
+pub fn counts<'py>(py: Python<'py>, counters: &[(&str, u32)]) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("frames", s.frames)?;
-    d.set_item("bad_checksum", s.bad_checksum)?;
-    d.set_item("bad_end", s.bad_end)?;
-    d.set_item("refused", s.refused)?;
-    d.set_item("discarded", s.discarded)?;
+    for (name, n) in counters {
+        d.set_item(*name, n)?;
+    }
     Ok(d)
 }
 
-/// The v1.0.0 board → master parser (32-byte `Telemetry`, 14-byte `ReadbackReply`): BCC and end
-/// byte checked, resynchronising on the next `7B` inside what it holds.
-#[pyclass(module = "chassis")]
-pub struct V1DownlinkParser {
-    inner: v1::DownlinkParser,
+/// A v1.0.0 parser's counters by name.
+pub fn v1_counts(s: v1::Stats) -> [(&'static str, u32); 5] {
+    [
+        ("frames", s.frames),
+        ("bad_checksum", s.bad_checksum),
+        ("bad_end", s.bad_end),
+        ("refused", s.refused),
+        ("discarded", s.discarded),
+    ]
 }
 
-#[pymethods]
-impl V1DownlinkParser {
-    #[new]
-    fn new() -> Self {
-        V1DownlinkParser {
-            inner: v1::DownlinkParser::new(),
+/// The frames `parse` finds in what it was fed (the GIL released meanwhile), each as its
+/// Python class (`class`).
+fn found<F: Send>(
+    py: Python<'_>,
+    parse: impl FnOnce() -> Vec<F> + Send,
+    class: fn(Python<'_>, F) -> PyResult<Py<PyAny>>,
+) -> PyResult<Vec<Py<PyAny>>> {
+    let found = crate::detach(py, parse);
+    found.into_iter().map(|f| class(py, f)).collect()
+}
+
+/// A v1.0.0 parser class (both directions are alike): `feed`, `quiet()`, `stats`.
+macro_rules! v1_parser {
+    ($(#[$doc:meta])* $class:ident($inner:ty) -> $frame:ty, $to_py:path) => {
+        $(#[$doc])*
+        #[pyclass(module = "chassis")]
+        pub struct $class {
+            inner: $inner,
         }
-    }
 
-    /// Takes bytes; the frames they complete.
-    fn feed(&mut self, py: Python<'_>, data: PyBackedBytes) -> PyResult<Vec<Py<PyAny>>> {
-        use v1::Parser as _;
-        let found: Vec<v1::Downlink> = crate::detach(py, || self.inner.frames(&data).collect());
-        found
-            .into_iter()
-            .map(|f| frames::v1_downlink(py, f))
-            .collect()
-    }
+        #[pymethods]
+        impl $class {
+            #[new]
+            fn new() -> Self {
+                $class {
+                    inner: <$inner>::new(),
+                }
+            }
 
-    /// The line has been quiet (2 ms on a UART, 25 ms behind a USB-UART): the start of a
-    /// frame cut short is thrown away; no frame spans a quiet line.
-    fn quiet(&mut self) {
-        self.inner.quiet();
-    }
+            /// Takes bytes; the frames they complete.
+            fn feed(&mut self, py: Python<'_>, data: PyBackedBytes) -> PyResult<Vec<Py<PyAny>>> {
+                use v1::Parser as _;
+                found(py, || self.inner.frames(&data).collect::<Vec<$frame>>(), $to_py)
+            }
 
-    /// Counters: frames, bad_checksum, bad_end, refused, discarded.
-    #[getter]
-    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        v1_stats(py, self.inner.stats())
-    }
-}
+            /// The line has been quiet (2 ms on a UART, 25 ms behind a USB-UART): the start of a
+            /// frame cut short is thrown away; no frame spans a quiet line.
+            fn quiet(&mut self) {
+                self.inner.quiet();
+            }
 
-/// The v1.0.0 master → board parser (commands), for captures: a body velocity as
-/// `BodyVelocity`, other commands as dicts with the frame's fields.
-#[pyclass(module = "chassis")]
-pub struct V1UplinkParser {
-    inner: v1::UplinkParser,
-}
-
-#[pymethods]
-impl V1UplinkParser {
-    #[new]
-    fn new() -> Self {
-        V1UplinkParser {
-            inner: v1::UplinkParser::new(),
+            /// Counters: frames, bad_checksum, bad_end, refused, discarded.
+            #[getter]
+            fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+                counts(py, &v1_counts(self.inner.stats()))
+            }
         }
-    }
-
-    /// Takes bytes; the commands they complete.
-    fn feed(&mut self, py: Python<'_>, data: PyBackedBytes) -> PyResult<Vec<Py<PyAny>>> {
-        use v1::Parser as _;
-        let found: Vec<v1::Command> = crate::detach(py, || self.inner.frames(&data).collect());
-        found
-            .into_iter()
-            .map(|f| frames::v1_uplink(py, f))
-            .collect()
-    }
-
-    /// The line has been quiet (2 ms on a UART, 25 ms behind a USB-UART): the start of a
-    /// frame cut short is thrown away; no frame spans a quiet line.
-    fn quiet(&mut self) {
-        self.inner.quiet();
-    }
-
-    /// Counters: frames, bad_checksum, bad_end, refused, discarded.
-    #[getter]
-    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        v1_stats(py, self.inner.stats())
-    }
+    };
 }
+
+v1_parser!(
+    /// The v1.0.0 board → master parser (32-byte `Telemetry`, 14-byte `ReadbackReply`): BCC and end
+    /// byte checked, resynchronising on the next `7B` inside what it holds.
+    V1DownlinkParser(v1::DownlinkParser) -> v1::Downlink,
+    frames::v1_downlink
+);
+
+v1_parser!(
+    /// The v1.0.0 master → board parser (commands), for captures: a body velocity as
+    /// `BodyVelocity`, other commands as dicts with the frame's fields.
+    V1UplinkParser(v1::UplinkParser) -> v1::Command,
+    frames::v1_uplink
+);
