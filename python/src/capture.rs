@@ -72,16 +72,13 @@ pub fn decode_capture(
     quiet_ms: Option<crate::args::Real>,
 ) -> PyResult<Decoded> {
     let input = input_of(input)?;
-    let firmware = match firmware {
-        None => None,
-        Some("2020") => Some(Firmware::V2020),
-        Some("v1.0.0" | "v1") => Some(Firmware::V1_0_0),
-        Some(other) => {
-            return Err(PyValueError::new_err(format!(
-                "firmware={other:?}: give \"2020\" or \"v1.0.0\""
-            )));
-        }
-    };
+    let firmware = firmware
+        .map(|name| {
+            Firmware::from_name(name).ok_or_else(|| {
+                PyValueError::new_err(format!("firmware={name:?}: give \"2020\" or \"v1.0.0\""))
+            })
+        })
+        .transpose()?;
     if let Some(q) = &quiet_ms {
         if !(q.value > 0.0 && q.value <= 60_000.0) {
             return Err(PyValueError::new_err(format!(

@@ -8,6 +8,7 @@ mod capture;
 mod driver;
 mod errors;
 mod frames;
+mod generation;
 mod json;
 mod parsers;
 mod signals;

@@ -2,7 +2,8 @@
 //! real time on a pseudo-terminal (`pty()`), so that every example and test runs on a laptop.
 
 use crate::args::Int;
-use chassis_protocol::sim::{self, Simulated, serve};
+use chassis_protocol::detect::Firmware;
+use chassis_protocol::sim::{Simulated, serve};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
@@ -12,61 +13,35 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
-/// Either generation's simulated board.
-enum AnyBoard {
-    V2020(Box<sim::Board>),
-    V1(Box<sim::v1::Board>),
-}
+/// Either generation's simulated board, as [`generation`](crate::generation) makes it.
+struct AnyBoard(Box<dyn Simulated + Send + Sync>);
 
 impl Simulated for AnyBoard {
     fn receive(&mut self, bytes: &[u8]) {
-        match self {
-            AnyBoard::V2020(b) => b.receive(bytes),
-            AnyBoard::V1(b) => b.receive(bytes),
-        }
+        self.0.receive(bytes);
     }
     fn advance(&mut self, now_ms: u64) {
-        match self {
-            AnyBoard::V2020(b) => b.advance(now_ms),
-            AnyBoard::V1(b) => b.advance(now_ms),
-        }
+        self.0.advance(now_ms);
     }
     fn transmit(&mut self, buf: &mut [u8]) -> usize {
-        match self {
-            AnyBoard::V2020(b) => b.transmit(buf),
-            AnyBoard::V1(b) => b.transmit(buf),
-        }
+        self.0.transmit(buf)
     }
     fn byte_arrived(&self) -> bool {
-        match self {
-            AnyBoard::V2020(b) => b.byte_arrived(),
-            AnyBoard::V1(b) => b.byte_arrived(),
-        }
+        self.0.byte_arrived()
     }
     fn now_ms(&self) -> u64 {
-        match self {
-            AnyBoard::V2020(b) => b.now_ms(),
-            AnyBoard::V1(b) => b.now_ms(),
-        }
+        self.0.now_ms()
     }
 }
 
+/// The simulated board of the generation `firmware` names.
 fn board(firmware: &str, seed: u64) -> PyResult<AnyBoard> {
-    match firmware {
-        "2020" => Ok(AnyBoard::V2020(Box::new(sim::Board::new(sim::SimConfig {
-            seed,
-            ..sim::SimConfig::default()
-        })))),
-        "v1.0.0" | "v1" => Ok(AnyBoard::V1(Box::new(sim::v1::Board::new(
-            sim::v1::SimConfig {
-                seed,
-                ..sim::v1::SimConfig::default()
-            },
-        )))),
-        other => Err(PyValueError::new_err(format!(
-            "firmware={other:?}: the simulated board runs 2020 or v1.0.0"
-        ))),
-    }
+    let firmware = Firmware::from_name(firmware).ok_or_else(|| {
+        PyValueError::new_err(format!(
+            "firmware={firmware:?}: the simulated board runs 2020 or v1.0.0"
+        ))
+    })?;
+    Ok(AnyBoard((crate::generation::of(firmware).board)(seed)))
 }
 
 /// A simulated board in this process, with no clock of its own: `receive` what a master sends,
