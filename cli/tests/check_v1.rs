@@ -1,7 +1,7 @@
 //! `chassis check` on a board running the v1.0.0 firmware, served on a real pseudo-terminal:
 //! the bring-up passes and ends with the forced stop, `--no-motion` sends only readbacks, every
 //! signal and a board gone quiet leave the forced stop as the last frame the board received, and
-//! nothing is ever written. The frames are written by hand from PROTOCOL-V1.md (BCC = XOR of
+//! nothing is ever written. The frames are written by hand from `docs/protocol-v1.md` (BCC = XOR of
 //! the bytes before it).
 
 #![cfg(unix)]

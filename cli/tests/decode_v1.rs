@@ -3,7 +3,7 @@
 //! 2020 captures decoded as before.
 //!
 //! The golden captures (`tests/golden/v1_*.hex`, `v1_both_logic2.csv`) and their JSON Lines were
-//! written by hand from PROTOCOL-V1.md's tables, never by the crate's encoder. Values are
+//! written by hand from the tables of `docs/protocol-v1.md`, never by the crate's encoder. Values are
 //! big-endian; each BCC is the XOR of every byte from the `7B` to the byte before it, worked
 //! out step by step below (each step the running XOR after the next byte; `00` bytes change
 //! nothing and are left out).
@@ -28,7 +28,7 @@
 //! * R36, motor speeds: ctl 2, type 4, 150, -150, 150, -150 (`00 96 FF 6A` twice): 7B, `36`
 //!   4D, `02` 4F, `04` 4B, `96` DD, `FF` 22, `6A` 48, `96` DE, `FF` 21, `6A` **4B**.
 //! * R50, PID 3000, 1050, 0, 3000, 1050 (`0B B8 04 1A 00 00 0B B8 04 1A`: the pairs cancel):
-//!   7B, `50` **2B** (as PROTOCOL-V1.md gives for the request).
+//!   7B, `50` **2B** (as `docs/protocol-v1.md` gives for the request).
 //! * T1 again.
 //!
 //! Master → board (`v1_uplink.hex`):
@@ -42,12 +42,12 @@
 //!   `A5` **D5**.
 //! * `0x24` 110, 110, 55, 60: 7B, `24` 5F, `6E` 31, `6E` 5F, `37` 68, `3C` **54**.
 //! * `0x40` 3000, 1050, 0, 3000, 1050 (cancelling): 7B, `40` **3B**.
-//! * The readback requests `0x33` (**48**), `0x50` (**2B**), as PROTOCOL-V1.md gives them, and
+//! * The readback requests `0x33` (**48**), `0x50` (**2B**), as `docs/protocol-v1.md` gives them, and
 //!   `0x36`: 7B, `36` **4D**.
 //!
 //! Both sides (`v1_both_logic2.csv`, one byte a row, 0.1 ms apart): the board sends T1 at
 //! 10 ms; the master asks for the geometry at 20 ms (`7B 34`, ten `00`, 7B ^ 34 = **4F**, as
-//! PROTOCOL-V1.md gives); the board replies R34 at 23 ms; the master sends `0x25` ctl 2, type 4,
+//! `docs/protocol-v1.md` gives); the board replies R34 at 23 ms; the master sends `0x25` ctl 2, type 4,
 //! vy 300 at 40 ms (7B, `25` 5E, `02` 5C, `04` 58, `01` 59, `2C` **75**); the board sends T2 at
 //! 55 ms.
 

@@ -2,7 +2,7 @@
 //! on both generations, a silent line and bytes of neither; `drive` stopped at its end and on
 //! every signal; `turn` refused with nothing sent; `get` / `set` / `settings` over the
 //! readbacks and the settings frames. The frames the board must receive are written by hand
-//! from PROTOCOL-V1.md (BCC = XOR of the bytes before it).
+//! from `docs/protocol-v1.md` (BCC = XOR of the bytes before it).
 
 mod harness;
 

@@ -1,6 +1,6 @@
 //! `chassis monitor [--drive]` on a board running the v1.0.0 firmware, in a terminal of its own
 //! (a pseudo-terminal), keys typed into it, against the simulated v1.0.0 board served on a real
-//! pseudo-terminal. The frames the board must receive are written by hand from PROTOCOL-V1.md:
+//! pseudo-terminal. The frames the board must receive are written by hand from `docs/protocol-v1.md`:
 //! `7B`, code, ten payload bytes, BCC = XOR of every byte before it, `7D`.
 
 #![cfg(unix)]

@@ -1,5 +1,5 @@
 //! `chassis sim --firmware v1.0.0`: the simulated v1.0.0 board through a real pseudo-terminal,
-//! spoken to with bytes written by hand from PROTOCOL-V1.md.
+//! spoken to with bytes written by hand from `docs/protocol-v1.md`.
 
 #![cfg(unix)]
 
@@ -8,7 +8,7 @@ use std::io::{BufRead, BufReader, Read, Write};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// The vendor's readback request for the system settings, as PROTOCOL-V1.md quotes it.
+/// The vendor's readback request for the system settings, as `docs/protocol-v1.md` quotes it.
 const READ_SYSTEM: [u8; 14] = [0x7B, 0x33, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x48, 0x7D];
 
 /// Its reply at power-up, the vendor example's 0, 10, 3600 (0E10), 2100 (0834), 165 (00A5):

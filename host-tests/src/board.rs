@@ -434,7 +434,7 @@ mod tests {
             .enumerate()
             .filter(|(i, w)| w[0] == 0xFF && (0xFA..=0xFC).contains(&w[1]) && !starts.contains(i))
             .count();
-        // "About a tenth of all 16-bit values look like a header" (PROTOCOL.md, B).
+        // "About a tenth of all 16-bit values look like a header" (`docs/protocol-2020.md`, "No checksum").
         assert!(
             false_headers as f64 > 0.4 * imu,
             "{false_headers} false headers in {imu} IMU frames"

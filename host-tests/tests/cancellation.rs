@@ -580,7 +580,7 @@ mod v1_board {
     use chassis_protocol::sim::v1::{Board as V1Board, SimConfig as V1Config};
     use chassis_protocol::v1::{BodyVelocity, Geometry, MotorVelocity, Readback};
 
-    // The frames a v1.0.0 board may receive, by hand from PROTOCOL-V1.md (BCC = XOR of the
+    // The frames a v1.0.0 board may receive, by hand from `docs/protocol-v1.md` (BCC = XOR of the
     // bytes before it, worked out by hand).
 
     /// `0x25`: vx 0, vy 300 mm/s (0x012C), wz 0, ctl 2, type 4.

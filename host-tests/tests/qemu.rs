@@ -24,7 +24,7 @@ const FORWARD: i32 = 13;
 const STRAFE: i32 = 14;
 const CONTROL_LOOP: i32 = 18;
 
-/// The v1.0.0 forced stop, by hand from PROTOCOL-V1.md: `7B`, code `25`, ten `00` (`ctl` 0,
+/// The v1.0.0 forced stop, by hand from `docs/protocol-v1.md`: `7B`, code `25`, ten `00` (`ctl` 0,
 /// type 0, vx vy wz 0, `00 00`), BCC `7B ^ 25 = 5E`, `7D`.
 const FORCED_STOP: [u8; 14] = [
     0x7B, 0x25, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x5E, 0x7D,

@@ -1,6 +1,6 @@
 //! The driver over a simulated v1.0.0 board: the failsafe's forced stop, its tolerance of the
 //! telemetry frames the board drops while it receives commands, and settings written only when
-//! asked. The bytes the board must receive are written by hand from PROTOCOL-V1.md.
+//! asked. The bytes the board must receive are written by hand from `docs/protocol-v1.md`.
 
 use chassis_protocol::driver::blocking::Driver;
 use chassis_protocol::driver::v1::{DriverCore, MIN_FAILSAFE_MS, Settings};
@@ -95,7 +95,7 @@ fn a_silent_board_gets_the_forced_stop_within_the_failsafe() {
     );
     assert_eq!(d.uart().board().velocity(), BodyVelocity::FORCED_STOP);
     assert_eq!(d.uart().board().forced_stops(), 1, "sent once");
-    // The frame the board took, byte for byte: the forced stop of PROTOCOL-V1.md.
+    // The frame the board took, byte for byte: the forced stop of `docs/protocol-v1.md`.
     let last = d.uart().board().received().last().copied().unwrap();
     assert_eq!(
         last.encode(),

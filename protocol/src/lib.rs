@@ -97,9 +97,11 @@
 //!
 //! # The spec, and where it is ambiguous
 //!
-//! The protocol is the vendor's (Traditional Chinese) document, restated in `PROTOCOL.md`. Its
-//! ambiguities and the decisions taken are noted where they apply: A1 on [`DriveType`], A2 and A3
-//! in [`command::motion`], A5 in [`telemetry::encoders`], A7 in [`parse::downlink`].
+//! The protocol is the vendor's (Traditional Chinese) document, restated with every frame, every
+//! ambiguity and the decision taken on it (A1–A13) in the repository's `docs/protocol-2020.md`
+//! (v1.0.0's, V1–V13: `docs/protocol-v1.md`). The decisions are noted where they apply: A1 on
+//! [`DriveType`], A2 and A3 in [`command::motion`], A5 in [`telemetry::encoders`], A7 in
+//! [`parse::downlink`].
 //!
 //! # Features
 //!

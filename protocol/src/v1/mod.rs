@@ -1,6 +1,6 @@
 //! The board's newer firmware, **v1.0.0** (2023): `7B … BCC 7D` frames, a different protocol
-//! on the same 115 200 bps UART (`PROTOCOL-V1.md` beside the spec: every fact, with how sure
-//! it is).
+//! on the same 115 200 bps UART (the repository's `docs/protocol-v1.md`: every fact, with how
+//! sure it is, and the decisions V1–V13).
 //!
 //! * Master → board: always 14 bytes, `7B`, a code, ten payload bytes, BCC, `7D`
 //!   ([`Command`]).

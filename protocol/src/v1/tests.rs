@@ -1,10 +1,10 @@
-//! v1.0.0 frames: golden bytes written by hand from PROTOCOL-V1.md (each BCC worked out by
+//! v1.0.0 frames: golden bytes written by hand from `docs/protocol-v1.md` (each BCC worked out by
 //! hand: the XOR of the bytes before it), round trips, and the parsers on clean, split,
 //! shifted and damaged streams.
 
 use super::*;
 
-/// The vendor's readback request for the system settings, as PROTOCOL-V1.md quotes it.
+/// The vendor's readback request for the system settings, as `docs/protocol-v1.md` quotes it.
 const READ_SYSTEM: [u8; 14] = [0x7B, 0x33, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x48, 0x7D];
 
 #[test]

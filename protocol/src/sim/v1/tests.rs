@@ -1,11 +1,11 @@
-//! The v1.0.0 board: frames in are written by hand from PROTOCOL-V1.md (each BCC worked out by
+//! The v1.0.0 board: frames in are written by hand from `docs/protocol-v1.md` (each BCC worked out by
 //! hand, the XOR of the bytes before it), never made by the encoder; what comes out is read
 //! with `v1::DownlinkParser`.
 
 use super::*;
 use crate::v1::{Downlink, DownlinkParser, Parser, Telemetry};
 
-/// The vendor's readback requests, as PROTOCOL-V1.md quotes them (BCC 48, 4F, 2B).
+/// The vendor's readback requests, as `docs/protocol-v1.md` quotes them (BCC 48, 4F, 2B).
 const READ_SYSTEM: [u8; 14] = [0x7B, 0x33, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x48, 0x7D];
 const READ_GEOMETRY: [u8; 14] = [0x7B, 0x34, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x4F, 0x7D];
 const READ_PID: [u8; 14] = [0x7B, 0x50, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x2B, 0x7D];
