@@ -152,6 +152,7 @@ pub mod registers;
 #[cfg(feature = "sim")]
 #[cfg_attr(docsrs, doc(cfg(feature = "sim")))]
 pub mod sim;
+pub mod stream;
 pub mod telemetry;
 pub mod units;
 pub mod v1;

@@ -32,9 +32,10 @@ mod fields;
 mod parse;
 mod telemetry;
 
+pub use crate::stream::{Frames, Parser};
 pub use command::{BodyVelocity, Command, Geometry, MotorVelocity, Pid, Readback, SystemSettings};
 pub use fields::{FIELDS, FieldError, Settings, field_readback};
-pub use parse::{DownlinkParser, Frames, Parser, Stats, UplinkParser};
+pub use parse::{DownlinkParser, Stats, UplinkParser};
 pub use telemetry::{Downlink, Reply, Telemetry};
 
 use crate::wire;

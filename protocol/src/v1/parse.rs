@@ -5,6 +5,7 @@
 //! once: the parser is never stuck, and never holds more than 32 bytes.
 
 use super::{COMMAND_LEN, Command, Downlink, END, START, TELEMETRY_LEN, bcc};
+use crate::stream::Parser;
 
 /// What a parser has seen.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -277,27 +278,6 @@ impl UplinkParser {
     }
 }
 
-/// A parser of one direction, for [`Frames`].
-pub trait Parser {
-    /// What it finds.
-    type Frame;
-    /// [`DownlinkParser::push`].
-    fn push(&mut self, byte: u8) -> Option<Self::Frame>;
-    /// [`DownlinkParser::poll`].
-    fn poll(&mut self) -> Option<Self::Frame>;
-
-    /// Every frame of `bytes`, in order.
-    fn frames<'p, 'b>(&'p mut self, bytes: &'b [u8]) -> Frames<'p, 'b, Self>
-    where
-        Self: Sized,
-    {
-        Frames {
-            parser: self,
-            bytes,
-        }
-    }
-}
-
 impl Parser for DownlinkParser {
     type Frame = Downlink;
     fn push(&mut self, byte: u8) -> Option<Downlink> {
@@ -305,6 +285,14 @@ impl Parser for DownlinkParser {
     }
     fn poll(&mut self) -> Option<Downlink> {
         DownlinkParser::poll(self)
+    }
+    fn quiet(&mut self, _ms: u32) -> Option<Downlink> {
+        // A frame's bytes come back to back: the start of one cut short by the quiet goes.
+        DownlinkParser::quiet(self);
+        DownlinkParser::poll(self)
+    }
+    fn buffered(&self) -> usize {
+        DownlinkParser::buffered(self)
     }
 }
 
@@ -316,28 +304,11 @@ impl Parser for UplinkParser {
     fn poll(&mut self) -> Option<Command> {
         UplinkParser::poll(self)
     }
-}
-
-/// The frames of a slice, in order ([`Parser::frames`]).
-#[derive(Debug)]
-pub struct Frames<'p, 'b, P> {
-    parser: &'p mut P,
-    bytes: &'b [u8],
-}
-
-impl<P: Parser> Iterator for Frames<'_, '_, P> {
-    type Item = P::Frame;
-
-    fn next(&mut self) -> Option<P::Frame> {
-        if let Some(frame) = self.parser.poll() {
-            return Some(frame);
-        }
-        while let Some((byte, rest)) = self.bytes.split_first() {
-            self.bytes = rest;
-            if let Some(frame) = self.parser.push(*byte) {
-                return Some(frame);
-            }
-        }
-        None
+    fn quiet(&mut self, _ms: u32) -> Option<Command> {
+        UplinkParser::quiet(self);
+        UplinkParser::poll(self)
+    }
+    fn buffered(&self) -> usize {
+        UplinkParser::buffered(self)
     }
 }
