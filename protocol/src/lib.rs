@@ -141,21 +141,18 @@
 mod arbitrary;
 mod bytes;
 mod codes;
-pub mod command;
 pub mod detect;
 #[cfg(feature = "driver")]
 #[cfg_attr(docsrs, doc(cfg(feature = "driver")))]
 pub mod driver;
 mod error;
-pub mod parse;
-pub mod registers;
 #[cfg(feature = "sim")]
 #[cfg_attr(docsrs, doc(cfg(feature = "sim")))]
 pub mod sim;
 pub mod stream;
-pub mod telemetry;
 pub mod units;
 pub mod v1;
+pub mod v2020;
 mod wire;
 
 pub use bytes::FrameBytes;
@@ -167,3 +164,4 @@ pub use error::Error;
 pub use parse::{DownlinkParser, DownlinkStats, Lock, UplinkParser, UplinkStats};
 pub use registers::Snapshot;
 pub use telemetry::{Battery, Downlink, DownlinkBytes, Encoders, Imu, Kind, Reply, Stream};
+pub use v2020::{command, parse, registers, telemetry};

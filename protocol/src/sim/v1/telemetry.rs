@@ -40,7 +40,7 @@ impl Streams {
 
 impl Board {
     /// Whether telemetry is paused (a settings frame arrived less than
-    /// [`SimConfig::settings_pause_ms`] ago).
+    /// [`SimConfig::settings_pause_ms`](super::SimConfig::settings_pause_ms) ago).
     #[must_use]
     pub const fn telemetry_paused(&self) -> bool {
         self.now_ms < self.streams.quiet_until_ms
@@ -53,7 +53,7 @@ impl Board {
     }
 
     /// Telemetry frames dropped for a command that arrived just before
-    /// ([`SimConfig::busy_drop_per_million`]).
+    /// ([`SimConfig::busy_drop_per_million`](super::SimConfig::busy_drop_per_million)).
     #[must_use]
     pub const fn telemetry_dropped(&self) -> u32 {
         self.streams.telemetry_dropped
