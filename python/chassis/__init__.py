@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import atexit
 import weakref
-from typing import Literal, Optional, Union, overload
+from typing import TYPE_CHECKING, Literal, Optional, Union, overload
 
 from . import sim
 from .chassis_native import (
@@ -93,43 +93,36 @@ __all__ = [
     "sim",
 ]
 
+if TYPE_CHECKING:
+    from typing import TypedDict
+
+    from typing_extensions import Unpack
+
+    class _OpenOptions(TypedDict, total=False):
+        """The limits `open()` takes besides the firmware, each `None` for the host default."""
+
+        failsafe_ms: Optional[int]
+        board_latency_ms: Optional[int]
+        idle_ms: Optional[int]
+        read_tries: Optional[int]
+
 # Every chassis still open when the interpreter exits is stopped and closed.
 _open_chassis: "weakref.WeakSet[Union[Chassis, ChassisV1]]" = weakref.WeakSet()
 
 
 @overload
-def open(
-    port: str,
-    *,
-    firmware: Literal["2020"],
-    failsafe_ms: Optional[int] = None,
-    board_latency_ms: Optional[int] = None,
-    idle_ms: Optional[int] = None,
-    read_tries: Optional[int] = None,
-) -> Chassis: ...
+def open(port: str, *, firmware: Literal["2020"], **options: Unpack[_OpenOptions]) -> Chassis: ...
 
 
 @overload
 def open(
-    port: str,
-    *,
-    firmware: Literal["v1.0.0", "v1"],
-    failsafe_ms: Optional[int] = None,
-    board_latency_ms: Optional[int] = None,
-    idle_ms: Optional[int] = None,
-    read_tries: Optional[int] = None,
+    port: str, *, firmware: Literal["v1.0.0", "v1"], **options: Unpack[_OpenOptions]
 ) -> ChassisV1: ...
 
 
 @overload
 def open(
-    port: str,
-    *,
-    firmware: Optional[str] = None,
-    failsafe_ms: Optional[int] = None,
-    board_latency_ms: Optional[int] = None,
-    idle_ms: Optional[int] = None,
-    read_tries: Optional[int] = None,
+    port: str, *, firmware: Optional[str] = None, **options: Unpack[_OpenOptions]
 ) -> Union[Chassis, ChassisV1]: ...
 
 
