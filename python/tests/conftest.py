@@ -22,6 +22,26 @@ FORCED_STOP = bytes.fromhex("7B 25 00 00 00 00 00 00 00 00 00 00 5E 7D")
 V1_FORWARD = bytes.fromhex("7B 25 02 04 00 00 01 2C 00 00 00 00 75 7D")
 
 
+# Per firmware: the frame that drives forward (the speed of `SPEEDS`), and that speed in the
+# units its `set_velocity` takes (2020: raw; v1.0.0: m/s).
+FORWARDS = {"2020": FORWARD, "v1.0.0": V1_FORWARD}
+SPEEDS = {"2020": 300, "v1.0.0": 0.3}
+
+# A program that drives forward in a loop on the board at `sys.argv[1]`, of firmware
+# `sys.argv[2]`, and says "driving" once the chassis is open.
+DRIVE = """
+    import sys, time
+    import chassis
+    firmware = sys.argv[2]
+    speed = 300 if firmware == "2020" else 0.3
+    with chassis.open(sys.argv[1], firmware=firmware) as bot:
+        print("driving", flush=True)
+        while True:
+            bot.set_velocity(0, speed, 0)
+            time.sleep(0.02)
+"""
+
+
 @pytest.fixture
 def board() -> Iterator[chassis.sim.Pty]:
     with chassis.sim.pty() as b:
@@ -32,6 +52,12 @@ def board() -> Iterator[chassis.sim.Pty]:
 def v1_board() -> Iterator[chassis.sim.Pty]:
     with chassis.sim.pty(firmware="v1.0.0") as b:
         yield b
+
+
+@pytest.fixture
+def target(firmware: str, board: chassis.sim.Pty, v1_board: chassis.sim.Pty) -> chassis.sim.Pty:
+    """The board of the test's `firmware` (both are served, as `board` and `v1_board`)."""
+    return board if firmware == "2020" else v1_board
 
 
 def frames_2020(data: bytes) -> list[bytes]:

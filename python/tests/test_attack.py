@@ -26,12 +26,12 @@ import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import Callable
+from typing import Any, Callable
 
 import pytest
 
 import chassis
-from conftest import FORWARD, STOPS, V1_FORWARD, motion, wait_until
+from conftest import DRIVE, FORWARDS, SPEEDS, STOPS, motion, wait_until
 
 # Bounds for a loaded 2-core machine: unloaded, the stop takes 1-2 ms and the exit 2-20 ms.
 STOP_WITHIN_S = 1.0
@@ -39,19 +39,6 @@ EXIT_WITHIN_S = 5.0
 # From the program's start to 2 s after it, closer together early on: before `import chassis`,
 # during it, during `open()`, the first frames, then driving.
 MOMENTS = [0.0, 0.05, 0.1, 0.15, 0.2, 0.3, 0.5, 1.0, 1.5, 2.0]
-
-DRIVE = """
-    import sys, time
-    import chassis
-    firmware = sys.argv[2]
-    speed = 300 if firmware == "2020" else 0.3
-    with chassis.open(sys.argv[1], firmware=firmware) as bot:
-        print("driving", flush=True)
-        while True:
-            bot.set_velocity(0, speed, 0)
-            time.sleep(0.02)
-"""
-
 
 @dataclass
 class Ending:
@@ -156,27 +143,25 @@ def test_a_driving_program_ended_by_a_signal_at_any_moment_leaves_the_chassis_st
 # ----- another thread's stop() or close() during each blocking call -----
 
 
-def blocking_calls_2020(bot: chassis.Chassis) -> dict[str, Callable[[], object]]:
-    saved = bot.settings()
-    return {
-        "read": lambda: bot.read("max-speed"),
-        "settings": bot.settings,
-        "write": lambda: bot.write("max-speed", 900),
-        "restore": lambda: bot.restore(saved),
-        "wait_turn": lambda: bot.wait_turn(10),
-        "wait_frame": lambda: bot.wait_frame(10),
-    }
+# Per firmware: what the blocking calls read, and write (a settings field, its value).
+READ = {"2020": "max-speed", "v1.0.0": "geometry"}
+WRITE = {"2020": ("max-speed", 900), "v1.0.0": ("wheel-diameter", 65)}
 
 
-def blocking_calls_v1(bot: chassis.ChassisV1) -> dict[str, Callable[[], object]]:
-    saved = bot.settings()
-    return {
-        "read": lambda: bot.read("geometry"),
+def blocking_calls(bot: chassis.Chassis | chassis.ChassisV1) -> dict[str, Callable[[], object]]:
+    """Each call of `bot` that waits for the board, by name (`wait_turn`: 2020 only)."""
+    saved: Any = bot.settings()
+    read, (field, value) = READ[bot.firmware], WRITE[bot.firmware]
+    calls: dict[str, Callable[[], object]] = {
+        "read": lambda: bot.read(read),
         "settings": bot.settings,
-        "write": lambda: bot.write("wheel-diameter", 65),
+        "write": lambda: bot.write(field, value),
         "restore": lambda: bot.restore(saved),
         "wait_frame": lambda: bot.wait_frame(10),
     }
+    if isinstance(bot, chassis.Chassis):
+        calls["wait_turn"] = lambda: bot.wait_turn(10)
+    return calls
 
 
 CALLS = [("2020", c) for c in ["read", "settings", "write", "restore", "wait_turn", "wait_frame"]] + [
@@ -200,15 +185,11 @@ def interrupt_a_blocked_call(firmware: str, call: str, how: str) -> Interrupted:
         # The failsafe set long: only the stop asked for can stop the chassis here.
         bot = chassis.open(board.path, firmware=firmware, failsafe_ms=5000)
         try:
-            calls = blocking_calls_2020(bot) if isinstance(bot, chassis.Chassis) else blocking_calls_v1(bot)
-            if isinstance(bot, chassis.Chassis):
-                bot.set_velocity(0, 300, 0)
-                if call == "wait_turn":
-                    bot.turn(360)
-                forward = FORWARD
-            else:
-                bot.set_velocity(0, 0.3, 0)
-                forward = V1_FORWARD
+            calls = blocking_calls(bot)
+            bot.set_velocity(0, SPEEDS[firmware], 0)  # type: ignore[arg-type]
+            if isinstance(bot, chassis.Chassis) and call == "wait_turn":
+                bot.turn(360)
+            forward = FORWARDS[firmware]
             wait_until("driving", lambda: forward in board.received or call == "wait_turn")
             ended: list[str] = []
 

@@ -12,7 +12,7 @@ import textwrap
 import pytest
 
 import chassis
-from conftest import FORWARD, STOPS, V1_FORWARD, motion, wait_until
+from conftest import FORWARDS, STOPS, motion, wait_until
 
 FORKED = """
     import multiprocessing, os, sys, time, chassis
@@ -55,9 +55,9 @@ FORKED = """
 @pytest.mark.parametrize("how", ["os.fork", "multiprocessing"])
 @pytest.mark.parametrize("firmware", ["2020", "v1.0.0"])
 def test_a_chassis_inherited_by_a_child_process_is_inert_there(
-    board: chassis.sim.Pty, v1_board: chassis.sim.Pty, firmware: str, how: str, what: str
+    target: chassis.sim.Pty, firmware: str, how: str, what: str
 ) -> None:
-    target, forward = (board, FORWARD) if firmware == "2020" else (v1_board, V1_FORWARD)
+    forward = FORWARDS[firmware]
     p = subprocess.run(
         [sys.executable, "-W", "ignore::DeprecationWarning", "-c", textwrap.dedent(FORKED), target.path, firmware, how, what],
         capture_output=True,

@@ -15,7 +15,7 @@ import time
 import pytest
 
 import chassis
-from conftest import FORWARD, STOPS, V1_FORWARD, motion, wait_until
+from conftest import DRIVE, FORWARD, FORWARDS, STOPS, V1_FORWARD, motion, wait_until
 
 # A stop within this of the signal: the guard's thread stops at once (about a millisecond);
 # the rest is room for a loaded machine.
@@ -50,29 +50,12 @@ def expect_line(p: subprocess.Popen[bytes], line: bytes) -> None:
     assert got == line, (got, p.stderr.read() if p.stderr and p.poll() is not None else b"")
 
 
-def boards(firmware: str, board: chassis.sim.Pty, v1_board: chassis.sim.Pty) -> tuple[chassis.sim.Pty, bytes]:
-    return (board, FORWARD) if firmware == "2020" else (v1_board, V1_FORWARD)
-
-
-DRIVE = """
-    import sys, time, chassis
-    firmware = sys.argv[2]
-    speed = 300 if firmware == "2020" else 0.3
-    with chassis.open(sys.argv[1], firmware=firmware) as bot:
-        print("driving", flush=True)
-        while True:
-            bot.set_velocity(0, speed, 0)
-            time.sleep(0.02)
-"""
-
-
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP], ids=["SIGTERM", "SIGHUP"])
 @pytest.mark.parametrize("firmware", ["2020", "v1.0.0"])
 def test_sigterm_and_sighup_stop_the_chassis_then_end_the_process_with_their_status(
-    board: chassis.sim.Pty, v1_board: chassis.sim.Pty, firmware: str, sig: signal.Signals
+    target: chassis.sim.Pty, firmware: str, sig: signal.Signals
 ) -> None:
-    target, forward = boards(firmware, board, v1_board)
-    stop = STOPS[firmware]
+    forward, stop = FORWARDS[firmware], STOPS[firmware]
     p = run(DRIVE, target.path, firmware)
     expect_line(p, b"driving\n")
     wait_until("driving", lambda: forward in target.received)

@@ -11,7 +11,7 @@ from typing import Callable
 import pytest
 
 import chassis
-from conftest import FORWARD, STOPS, V1_FORWARD, motion, wait_until
+from conftest import FORWARDS, SPEEDS, STOPS, motion, wait_until
 
 # A read on a silent board gives up after 2.4-2.5 s: a stop waiting behind it took that long.
 # The stop goes out within a turn of the pump (a millisecond); the rest is room for a loaded
@@ -50,10 +50,9 @@ def blocked_then(bot: chassis.Chassis | chassis.ChassisV1, call: Callable[[], ob
 @pytest.mark.parametrize("call", ["read", "settings"])
 @pytest.mark.parametrize("firmware", ["2020", "v1.0.0"])
 def test_a_stop_of_another_thread_goes_out_at_once_while_a_call_waits(
-    board: chassis.sim.Pty, v1_board: chassis.sim.Pty, firmware: str, call: str, how: str
+    target: chassis.sim.Pty, firmware: str, call: str, how: str
 ) -> None:
-    target, forward, speed = (board, FORWARD, 300) if firmware == "2020" else (v1_board, V1_FORWARD, 0.3)
-    stop = STOPS[firmware]
+    forward, speed, stop = FORWARDS[firmware], SPEEDS[firmware], STOPS[firmware]
     # The failsafe set long: only the stop asked for can stop the chassis here.
     bot = chassis.open(target.path, firmware=firmware, failsafe_ms=5000)
     bot.set_velocity(0, speed, 0)  # type: ignore[arg-type]
@@ -80,17 +79,13 @@ def test_a_stop_of_another_thread_goes_out_at_once_while_a_call_waits(
 
 
 @pytest.mark.parametrize("firmware", ["2020", "v1.0.0"])
-def test_the_failsafe_keeps_its_time_while_another_thread_reads(
-    board: chassis.sim.Pty, v1_board: chassis.sim.Pty, firmware: str
-) -> None:
+def test_the_failsafe_keeps_its_time_while_another_thread_reads(target: chassis.sim.Pty, firmware: str) -> None:
     # A thread reads in a loop (answered, then unanswered once the board goes silent); the
     # failsafe still stops the chassis its own time after the board was last heard (2020:
     # 200 ms; v1.0.0: 300 ms). It took 0.6 s (2020) and, on v1.0.0, never while readbacks kept
     # being asked for, or 0.9 s.
-    target, forward, speed, failsafe = (
-        (board, FORWARD, 300, 0.2) if firmware == "2020" else (v1_board, V1_FORWARD, 0.3, 0.3)
-    )
-    stop = STOPS[firmware]
+    forward, speed, stop = FORWARDS[firmware], SPEEDS[firmware], STOPS[firmware]
+    failsafe = 0.2 if firmware == "2020" else 0.3
     bot = chassis.open(target.path, firmware=firmware)
     done = threading.Event()
 
