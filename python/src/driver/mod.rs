@@ -17,7 +17,7 @@
 //! streams, counters) and [`class`] (the macro that makes a chassis class with the methods every
 //! chassis has). Each generation's module holds what differs: [`v2020`] (`Chassis`: velocity in
 //! raw units, motors, turns, registers) and [`v1`] (`ChassisV1`: velocity in SI units, motors,
-//! readbacks, settings frames). [`open`](opening::open) opens the port and finds the firmware;
+//! readbacks, settings frames). [`open`] opens the port and finds the firmware;
 //! [`crate::generation`] turns it into the chassis that serves it.
 
 mod class;
