@@ -149,6 +149,9 @@ impl<W: Wire> Safety<W> {
     }
 
     /// Puts `frame` in the free slot (the caller checked [`slot_free`](Self::slot_free)).
+    // Out of line: seven callers (every frame the core sends) share one copy (`size_driver`:
+    // 100 B).
+    #[inline(never)]
     pub(crate) fn load(&mut self, frame: W::Frame, kind: FrameKind) {
         // The board pauses its telemetry while settings are made, reads included (A13). A
         // write or an action is answered by nothing: its pause is allowed from when it goes. A
