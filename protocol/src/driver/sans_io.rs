@@ -1119,6 +1119,9 @@ impl DriverCore {
     }
 
     /// The request ended (a read answered for the last time, an error).
+    // Out of line: ten callers, each copying an outcome that may hold a whole snapshot
+    // (`size_driver`: 112 B).
+    #[inline(never)]
     fn finish(&mut self, outcome: Result<Outcome, CoreError>) {
         if let Some(job) = self.job.take() {
             if !job.background {
