@@ -146,6 +146,19 @@ impl StreamInfo {
     }
 }
 
+/// A frame the user sends without a request ([`DriverCore::user_frame`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum UserFrame {
+    /// [`DriverCore::velocity`].
+    Velocity(Velocity),
+    /// [`DriverCore::motors`].
+    Motors(Motors),
+    /// [`DriverCore::write`].
+    Write(Write),
+    /// [`DriverCore::action`].
+    Action(Action),
+}
+
 /// Something the core saw on the line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -459,24 +472,12 @@ impl DriverCore {
     /// Queues a body-velocity frame (safe to send again and again). [`CoreError::FramePending`]
     /// while another frame is still to go out ([`transmit`](Self::transmit) it first).
     pub fn velocity(&mut self, velocity: Velocity, now_ms: u64) -> Result<(), CoreError> {
-        let now = self.safety.advance(now_ms);
-        self.ready_for_frame(now)?;
-        self.safety
-            .queue(Outgoing::new(&velocity.encode()), FrameKind::Motion)?;
-        let moving = velocity.x != 0 || velocity.y != 0 || velocity.z != 0;
-        self.safety.set_moving(moving || self.turning(), now);
-        Ok(())
+        self.user_frame(UserFrame::Velocity(velocity), now_ms)
     }
 
     /// Queues a per-motor frame; as [`velocity`](Self::velocity).
     pub fn motors(&mut self, motors: Motors, now_ms: u64) -> Result<(), CoreError> {
-        let now = self.safety.advance(now_ms);
-        self.ready_for_frame(now)?;
-        self.safety
-            .queue(Outgoing::new(&motors.encode()), FrameKind::Motion)?;
-        let moving = motors.values.iter().any(|v| *v != 0);
-        self.safety.set_moving(moving || self.turning(), now);
-        Ok(())
+        self.user_frame(UserFrame::Motors(motors), now_ms)
     }
 
     /// Queues the stop frame (all velocities 0), ahead of anything not yet begun (a frame
@@ -512,10 +513,8 @@ impl DriverCore {
             TurnState::Turning { .. } => return Err(CoreError::TurnInProgress),
             TurnState::Idle => {}
         }
-        self.ready_for_frame(now)?;
         let deci_degrees = turn.deci_degrees;
-        self.safety
-            .queue(Outgoing::new(&turn.encode()), FrameKind::Motion)?;
+        self.queue_frame(now, Outgoing::new(&turn.encode()), FrameKind::Motion)?;
         self.turn = TurnState::Turning { deci_degrees };
         self.safety.set_moving(true, now);
         Ok(())
@@ -548,20 +547,46 @@ impl DriverCore {
     /// Queues a register write. The board pauses its telemetry while settings are made; the
     /// failsafe allows for it (see the module docs). As [`velocity`](Self::velocity).
     pub fn write(&mut self, write: Write, now_ms: u64) -> Result<(), CoreError> {
-        let now = self.safety.advance(now_ms);
-        self.ready_for_frame(now)?;
-        let frame = Setting::Write(write).encode();
-        self.safety
-            .queue(Outgoing::new(&frame), FrameKind::Settings)
+        self.user_frame(UserFrame::Write(write), now_ms)
     }
 
     /// Queues an action (2A). As [`write`](Self::write).
     pub fn action(&mut self, action: Action, now_ms: u64) -> Result<(), CoreError> {
+        self.user_frame(UserFrame::Action(action), now_ms)
+    }
+
+    /// Queues a frame the user sends without a request (motion or a setting): what
+    /// [`velocity`](Self::velocity), [`motors`](Self::motors), [`write`](Self::write) and
+    /// [`action`](Self::action) do, in one body the shells share.
+    pub(crate) fn user_frame(&mut self, frame: UserFrame, now_ms: u64) -> Result<(), CoreError> {
         let now = self.safety.advance(now_ms);
-        self.ready_for_frame(now)?;
-        let frame = Setting::Action(action).encode();
-        self.safety
-            .queue(Outgoing::new(&frame), FrameKind::Settings)
+        let (bytes, kind, moving) = match frame {
+            UserFrame::Velocity(v) => (
+                Outgoing::new(&v.encode()),
+                FrameKind::Motion,
+                Some(v.x != 0 || v.y != 0 || v.z != 0),
+            ),
+            UserFrame::Motors(m) => (
+                Outgoing::new(&m.encode()),
+                FrameKind::Motion,
+                Some(m.values.iter().any(|v| *v != 0)),
+            ),
+            UserFrame::Write(w) => (
+                Outgoing::new(&Setting::Write(w).encode()),
+                FrameKind::Settings,
+                None,
+            ),
+            UserFrame::Action(a) => (
+                Outgoing::new(&Setting::Action(a).encode()),
+                FrameKind::Settings,
+                None,
+            ),
+        };
+        self.queue_frame(now, bytes, kind)?;
+        if let Some(moving) = moving {
+            self.safety.set_moving(moving || self.turning(), now);
+        }
+        Ok(())
     }
 
     // ----- requests -----
@@ -885,6 +910,15 @@ impl DriverCore {
     }
 
     // ----- inside -----
+
+    /// Puts a frame the user asked for in the slot, once nothing else is to go out before it
+    /// ([`ready_for_frame`](Self::ready_for_frame)).
+    // Out of line: one copy for the five frames a user sends without a request.
+    #[inline(never)]
+    fn queue_frame(&mut self, now: u64, frame: Outgoing, kind: FrameKind) -> Result<(), CoreError> {
+        self.ready_for_frame(now)?;
+        self.safety.queue(frame, kind)
+    }
 
     /// [`CoreError::FramePending`] while anything is still to go out: the frame in the slot, a
     /// queued stop, or a frame of the request in progress.
