@@ -1034,21 +1034,19 @@ impl DriverCore {
             sent_ms,
             until_ms,
         };
-        // A free place, or the one that ends first.
-        let place = self
-            .ghosts
-            .iter()
-            .position(Option::is_none)
-            .or_else(|| {
-                (0..GHOSTS).min_by_key(|i| {
-                    self.ghosts
-                        .get(*i)
-                        .copied()
-                        .flatten()
-                        .map_or(0, |g| g.until_ms)
-                })
-            })
-            .unwrap_or(0);
+        // A free place, or the one that ends first (the first of those that end first).
+        let mut place = 0;
+        let mut first_end = u64::MAX;
+        for (i, slot) in self.ghosts.iter().enumerate() {
+            let Some(g) = slot else {
+                place = i;
+                break;
+            };
+            if g.until_ms < first_end {
+                first_end = g.until_ms;
+                place = i;
+            }
+        }
         if let Some(slot) = self.ghosts.get_mut(place) {
             *slot = Some(ghost);
         }
