@@ -224,6 +224,8 @@ impl<W: Wire> Safety<W> {
     }
 
     /// A settings frame left: the board may pause its telemetry.
+    // Out of line: a write, an action and a read's reply share it (`size_driver`: 8 B).
+    #[inline(never)]
     pub(crate) fn settings_sent(&mut self, now_ms: u64) {
         self.settings_sent_ms = Some(now_ms);
         self.telemetry_after_settings = 0;

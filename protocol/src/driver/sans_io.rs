@@ -609,6 +609,8 @@ impl DriverCore {
     /// that comes later is a stray one. Shells call it when a transport error or a dropped
     /// future cuts a request short, so no error leaves the driver busy. A frame already going
     /// out is still finished ([`transmit`](Self::transmit)).
+    // Out of line: the shells call it on every error path (`size_driver`: 12 B).
+    #[inline(never)]
     pub fn abort(&mut self) {
         self.end_job(Ok(Outcome::Done));
         self.outcome = None;
