@@ -22,6 +22,7 @@
 //! # Ok::<(), chassis_protocol::driver::Error<core::convert::Infallible>>(())
 //! ```
 
+use super::sans_io::UserFrame;
 use super::{Clock, Config, Core, CoreError, DriverCore, Error, Outcome, Readable, Request, v1};
 use crate::command::{Action, Motors, Register, Turn, Velocity, Write};
 use crate::registers::Snapshot;
@@ -312,18 +313,12 @@ where
 {
     /// Sets the body velocity (see [`Velocity`] for the drive types). Safe to call every period.
     pub fn set_velocity(&mut self, velocity: Velocity) -> Result<(), Error<U::Error>> {
-        let now = self.clock.now_ms();
-        self.flush_out(now)?;
-        self.core.velocity(velocity, now)?;
-        self.flush_out(now)
+        self.user_frame(UserFrame::Velocity(velocity))
     }
 
     /// Drives each motor ([`Motors::closed_loop`] or [`Motors::open_loop_duty`]).
     pub fn set_motors(&mut self, motors: Motors) -> Result<(), Error<U::Error>> {
-        let now = self.clock.now_ms();
-        self.flush_out(now)?;
-        self.core.motors(motors, now)?;
-        self.flush_out(now)
+        self.user_frame(UserFrame::Motors(motors))
     }
 
     /// Sends a turn, **once**: the turn is consumed, and while one is outstanding a new one is
@@ -379,18 +374,12 @@ where
 
     /// Writes one register (2B). The board does not answer writes.
     pub fn write(&mut self, write: Write) -> Result<(), Error<U::Error>> {
-        let now = self.clock.now_ms();
-        self.flush_out(now)?;
-        self.core.write(write, now)?;
-        self.flush_out(now)
+        self.user_frame(UserFrame::Write(write))
     }
 
     /// Runs one action (2A).
     pub fn action(&mut self, action: Action) -> Result<(), Error<U::Error>> {
-        let now = self.clock.now_ms();
-        self.flush_out(now)?;
-        self.core.action(action, now)?;
-        self.flush_out(now)
+        self.user_frame(UserFrame::Action(action))
     }
 
     /// Reads every register of a [`Snapshot`], each read verified.
@@ -404,6 +393,16 @@ where
     /// Writes a snapshot back ([`Request::RestoreSettings`]: never starts a calibration).
     pub fn restore_settings(&mut self, settings: &Snapshot) -> Result<(), Error<U::Error>> {
         self.run(Request::RestoreSettings(*settings)).map(|_| ())
+    }
+
+    /// Finishes what is to go out, then sends `frame`.
+    // Out of line: one body for the four calls that send a frame without a request.
+    #[inline(never)]
+    fn user_frame(&mut self, frame: UserFrame) -> Result<(), Error<U::Error>> {
+        let now = self.clock.now_ms();
+        self.flush_out(now)?;
+        self.core.user_frame(frame, now)?;
+        self.flush_out(now)
     }
 
     fn value(&mut self, request: Request) -> Result<u32, Error<U::Error>> {

@@ -109,6 +109,9 @@ impl<W: Wire> Safety<W> {
     // ----- time -----
 
     /// The core's time for the caller's clock reading, kept.
+    // Out of line: every call of the core starts with it, and its `u64` arithmetic inlined in
+    // each costs more flash on a 32-bit core than the call (`size_driver`: 684 B).
+    #[inline(never)]
     pub(crate) fn advance(&mut self, raw_ms: u64) -> u64 {
         self.time.advance(raw_ms)
     }
@@ -146,6 +149,9 @@ impl<W: Wire> Safety<W> {
     }
 
     /// Puts `frame` in the free slot (the caller checked [`slot_free`](Self::slot_free)).
+    // Out of line: seven callers (every frame the core sends) share one copy (`size_driver`:
+    // 100 B).
+    #[inline(never)]
     pub(crate) fn load(&mut self, frame: W::Frame, kind: FrameKind) {
         // The board pauses its telemetry while settings are made, reads included (A13). A
         // write or an action is answered by nothing: its pause is allowed from when it goes. A
@@ -166,6 +172,8 @@ impl<W: Wire> Safety<W> {
 
     /// Queues the stop frame ahead of everything not yet begun, and takes the chassis as
     /// stopped.
+    // Out of line: `stop()` and the failsafe share it (`size_driver`: 28 B).
+    #[inline(never)]
     pub(crate) fn queue_stop(&mut self) {
         self.moving_since_ms = None;
         self.stop_queued = true;
@@ -216,12 +224,16 @@ impl<W: Wire> Safety<W> {
     }
 
     /// A settings frame left: the board may pause its telemetry.
+    // Out of line: a write, an action and a read's reply share it (`size_driver`: 8 B).
+    #[inline(never)]
     pub(crate) fn settings_sent(&mut self, now_ms: u64) {
         self.settings_sent_ms = Some(now_ms);
         self.telemetry_after_settings = 0;
     }
 
     /// A frame of any kind was heard at `at_ms`.
+    // Out of line: telemetry and replies share it (`size_driver`: 24 B).
+    #[inline(never)]
     pub(crate) fn heard(&mut self, at_ms: u64) {
         self.last_heard_ms = Some(self.last_heard_ms.map_or(at_ms, |t| t.max(at_ms)));
     }

@@ -146,6 +146,19 @@ impl StreamInfo {
     }
 }
 
+/// A frame the user sends without a request ([`DriverCore::user_frame`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum UserFrame {
+    /// [`DriverCore::velocity`].
+    Velocity(Velocity),
+    /// [`DriverCore::motors`].
+    Motors(Motors),
+    /// [`DriverCore::write`].
+    Write(Write),
+    /// [`DriverCore::action`].
+    Action(Action),
+}
+
 /// Something the core saw on the line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -459,24 +472,12 @@ impl DriverCore {
     /// Queues a body-velocity frame (safe to send again and again). [`CoreError::FramePending`]
     /// while another frame is still to go out ([`transmit`](Self::transmit) it first).
     pub fn velocity(&mut self, velocity: Velocity, now_ms: u64) -> Result<(), CoreError> {
-        let now = self.safety.advance(now_ms);
-        self.ready_for_frame(now)?;
-        self.safety
-            .queue(Outgoing::new(&velocity.encode()), FrameKind::Motion)?;
-        let moving = velocity.x != 0 || velocity.y != 0 || velocity.z != 0;
-        self.safety.set_moving(moving || self.turning(), now);
-        Ok(())
+        self.user_frame(UserFrame::Velocity(velocity), now_ms)
     }
 
     /// Queues a per-motor frame; as [`velocity`](Self::velocity).
     pub fn motors(&mut self, motors: Motors, now_ms: u64) -> Result<(), CoreError> {
-        let now = self.safety.advance(now_ms);
-        self.ready_for_frame(now)?;
-        self.safety
-            .queue(Outgoing::new(&motors.encode()), FrameKind::Motion)?;
-        let moving = motors.values.iter().any(|v| *v != 0);
-        self.safety.set_moving(moving || self.turning(), now);
-        Ok(())
+        self.user_frame(UserFrame::Motors(motors), now_ms)
     }
 
     /// Queues the stop frame (all velocities 0), ahead of anything not yet begun (a frame
@@ -512,10 +513,8 @@ impl DriverCore {
             TurnState::Turning { .. } => return Err(CoreError::TurnInProgress),
             TurnState::Idle => {}
         }
-        self.ready_for_frame(now)?;
         let deci_degrees = turn.deci_degrees;
-        self.safety
-            .queue(Outgoing::new(&turn.encode()), FrameKind::Motion)?;
+        self.queue_frame(now, Outgoing::new(&turn.encode()), FrameKind::Motion)?;
         self.turn = TurnState::Turning { deci_degrees };
         self.safety.set_moving(true, now);
         Ok(())
@@ -548,20 +547,46 @@ impl DriverCore {
     /// Queues a register write. The board pauses its telemetry while settings are made; the
     /// failsafe allows for it (see the module docs). As [`velocity`](Self::velocity).
     pub fn write(&mut self, write: Write, now_ms: u64) -> Result<(), CoreError> {
-        let now = self.safety.advance(now_ms);
-        self.ready_for_frame(now)?;
-        let frame = Setting::Write(write).encode();
-        self.safety
-            .queue(Outgoing::new(&frame), FrameKind::Settings)
+        self.user_frame(UserFrame::Write(write), now_ms)
     }
 
     /// Queues an action (2A). As [`write`](Self::write).
     pub fn action(&mut self, action: Action, now_ms: u64) -> Result<(), CoreError> {
+        self.user_frame(UserFrame::Action(action), now_ms)
+    }
+
+    /// Queues a frame the user sends without a request (motion or a setting): what
+    /// [`velocity`](Self::velocity), [`motors`](Self::motors), [`write`](Self::write) and
+    /// [`action`](Self::action) do, in one body the shells share.
+    pub(crate) fn user_frame(&mut self, frame: UserFrame, now_ms: u64) -> Result<(), CoreError> {
         let now = self.safety.advance(now_ms);
-        self.ready_for_frame(now)?;
-        let frame = Setting::Action(action).encode();
-        self.safety
-            .queue(Outgoing::new(&frame), FrameKind::Settings)
+        let (bytes, kind, moving) = match frame {
+            UserFrame::Velocity(v) => (
+                Outgoing::new(&v.encode()),
+                FrameKind::Motion,
+                Some(v.x != 0 || v.y != 0 || v.z != 0),
+            ),
+            UserFrame::Motors(m) => (
+                Outgoing::new(&m.encode()),
+                FrameKind::Motion,
+                Some(m.values.iter().any(|v| *v != 0)),
+            ),
+            UserFrame::Write(w) => (
+                Outgoing::new(&Setting::Write(w).encode()),
+                FrameKind::Settings,
+                None,
+            ),
+            UserFrame::Action(a) => (
+                Outgoing::new(&Setting::Action(a).encode()),
+                FrameKind::Settings,
+                None,
+            ),
+        };
+        self.queue_frame(now, bytes, kind)?;
+        if let Some(moving) = moving {
+            self.safety.set_moving(moving || self.turning(), now);
+        }
+        Ok(())
     }
 
     // ----- requests -----
@@ -584,6 +609,8 @@ impl DriverCore {
     /// that comes later is a stray one. Shells call it when a transport error or a dropped
     /// future cuts a request short, so no error leaves the driver busy. A frame already going
     /// out is still finished ([`transmit`](Self::transmit)).
+    // Out of line: the shells call it on every error path (`size_driver`: 12 B).
+    #[inline(never)]
     pub fn abort(&mut self) {
         self.end_job(Ok(Outcome::Done));
         self.outcome = None;
@@ -715,6 +742,9 @@ impl DriverCore {
 
     /// Feeds the bytes read into [`rx_space`](Self::rx_space) to the parser until one
     /// completes an event.
+    // Out of line: the parser it runs stays one function, not a copy inlined into a shell's
+    // pump (`size_driver`: 88 B).
+    #[inline(never)]
     pub fn drain(&mut self, now_ms: u64) -> Option<Event> {
         if self.rx.is_empty() {
             return None;
@@ -886,6 +916,15 @@ impl DriverCore {
 
     // ----- inside -----
 
+    /// Puts a frame the user asked for in the slot, once nothing else is to go out before it
+    /// ([`ready_for_frame`](Self::ready_for_frame)).
+    // Out of line: one copy for the five frames a user sends without a request.
+    #[inline(never)]
+    fn queue_frame(&mut self, now: u64, frame: Outgoing, kind: FrameKind) -> Result<(), CoreError> {
+        self.ready_for_frame(now)?;
+        self.safety.queue(frame, kind)
+    }
+
     /// [`CoreError::FramePending`] while anything is still to go out: the frame in the slot, a
     /// queued stop, or a frame of the request in progress.
     fn ready_for_frame(&self, now: u64) -> Result<(), CoreError> {
@@ -943,6 +982,8 @@ impl DriverCore {
         }
     }
 
+    // Out of line: `start`, `stop` and the failsafe's turn cancel share it (`size_driver`: 20 B).
+    #[inline(never)]
     fn begin(&mut self, request: Request, background: bool) {
         let step = match request {
             Request::Read(register) => Step::Read(Read::new(register, Check::Once)),
@@ -995,21 +1036,19 @@ impl DriverCore {
             sent_ms,
             until_ms,
         };
-        // A free place, or the one that ends first.
-        let place = self
-            .ghosts
-            .iter()
-            .position(Option::is_none)
-            .or_else(|| {
-                (0..GHOSTS).min_by_key(|i| {
-                    self.ghosts
-                        .get(*i)
-                        .copied()
-                        .flatten()
-                        .map_or(0, |g| g.until_ms)
-                })
-            })
-            .unwrap_or(0);
+        // A free place, or the one that ends first (the first of those that end first).
+        let mut place = 0;
+        let mut first_end = u64::MAX;
+        for (i, slot) in self.ghosts.iter().enumerate() {
+            let Some(g) = slot else {
+                place = i;
+                break;
+            };
+            if g.until_ms < first_end {
+                first_end = g.until_ms;
+                place = i;
+            }
+        }
         if let Some(slot) = self.ghosts.get_mut(place) {
             *slot = Some(ghost);
         }
@@ -1119,6 +1158,9 @@ impl DriverCore {
     }
 
     /// The request ended (a read answered for the last time, an error).
+    // Out of line: ten callers, each copying an outcome that may hold a whole snapshot
+    // (`size_driver`: 112 B).
+    #[inline(never)]
     fn finish(&mut self, outcome: Result<Outcome, CoreError>) {
         if let Some(job) = self.job.take() {
             if !job.background {
