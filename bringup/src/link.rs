@@ -1,19 +1,22 @@
-//! [`Link`]: what the bring-up needs from a driver, so that it is written once for both shells.
+//! The driver under the bring-up, for both generations and both shells.
+//!
+//! [`Common`] is what both generations' bring-ups need of a driver (the clock, the core,
+//! telemetry in, the stop, progress notes); each generation's `Link` adds its own calls
+//! ([`v2020::Link`](crate::v2020::Link), [`v1::Link`](crate::v1::Link)).
 //!
 //! `Blocking` (feature `blocking`) wraps the blocking driver (any HAL with embedded-io 0.7
-//! `Read + Write + ReadReady`, or embedded-hal-nb serial through `NbSerial`); `Async` (feature
-//! `async`) wraps the async one (embassy's `BufferedUart`). With `blocking`, [`Link`]'s calls
-//! are plain functions and the bring-up is plain blocking code: no executor, no future.
-//!
-//! Both wrappers take the driver's core as a parameter, as the driver does: `Blocking::new`
-//! and `Async::new` make the 2020 driver (a [`Link`]), `Blocking::new_v1` and `Async::new_v1`
-//! the v1.0.0 one (a [`LinkV1`](crate::v1::LinkV1), implemented in [`crate::v1`]).
+//! `Read + Write + ReadReady`, or embedded-hal-nb serial through `NbSerial`); `Async`
+//! (feature `async`) wraps the async one (embassy's `BufferedUart`). With `blocking`, the
+//! links' calls are plain functions and the bring-up is plain blocking code: no executor, no
+//! future. Both take the driver's core as a parameter `K`, as the driver does, and implement
+//! [`Common`] for either; each generation names them over its own core (`v2020::Blocking`,
+//! `v1::Blocking`, `v2020::Async`, `v1::Async`: made with `new`) and implements its `Link` on
+//! them.
 
+use crate::Note;
 #[cfg(any(feature = "blocking", feature = "async"))]
-use chassis_protocol::driver::{Clock, CoreError, Outcome, Request};
-use chassis_protocol::driver::{DriverCore, Error, Event};
-use chassis_protocol::registers::Snapshot;
-use chassis_protocol::{Register, Turn, Velocity, Write};
+use chassis_protocol::driver::Clock;
+use chassis_protocol::driver::{Config, Core, DriverCore, Error};
 
 /// A driver error with its transport error reduced to its kind, so that one bring-up serves
 /// every HAL.
@@ -24,76 +27,84 @@ pub(crate) fn kind<E: embedded_io::Error>(e: Error<E>) -> LinkError {
     e.map_transport(|e| e.kind())
 }
 
-/// The calls the bring-up makes; each is the driver call of the same name.
+/// The calls both generations' bring-ups make; each is the driver call of the same name. Each
+/// generation's `Link` has these and adds its own.
 ///
 /// `async` (the futures are not `Send`: a bring-up runs on one core, in one task), or plain
 /// functions with feature `blocking`.
 #[allow(async_fn_in_trait)]
 #[maybe_async::maybe_async(AFIT)]
-pub trait Link {
+pub trait Common {
+    /// The driver's sans-IO core: [`DriverCore`] on 2020, `driver::v1::DriverCore` on v1.0.0.
+    type Core;
+    /// What the core says it saw (its `Event`: telemetry, a reply nobody awaited…).
+    type Event;
     /// Milliseconds since boot (the driver's clock).
     fn now_ms(&mut self) -> u64;
-    /// The driver's sans-IO core: latest telemetry, counters.
-    fn core(&self) -> &DriverCore;
+    /// The driver's sans-IO core: latest telemetry, parser counters, failsafe stops.
+    fn core(&self) -> &Self::Core;
     /// Takes in what has arrived; the blocking shell returns at once, the async one waits a
     /// little for bytes.
-    async fn poll(&mut self) -> Result<Option<Event>, LinkError>;
-    /// Sets the body velocity.
-    async fn set_velocity(&mut self, velocity: Velocity) -> Result<(), LinkError>;
-    /// Stops (and cancels a turn in progress).
+    async fn poll(&mut self) -> Result<Option<Self::Event>, LinkError>;
+    /// The generation's stop: on 2020 a stop (and a turn in progress cancelled), on v1.0.0
+    /// the forced stop.
     async fn stop(&mut self) -> Result<(), LinkError>;
-    /// Sends a turn, once.
-    async fn turn(&mut self, turn: Turn) -> Result<(), LinkError>;
-    /// The angle still to turn, 0.1°.
-    async fn turn_remaining(&mut self) -> Result<i32, LinkError>;
-    /// Every register, each read verified.
-    async fn read_settings(&mut self) -> Result<Snapshot, LinkError>;
-    /// One register, untyped, read until two replies agree (there is no checksum: one reply
-    /// can carry a changed byte).
-    async fn read_verified(&mut self, register: Register) -> Result<u32, LinkError>;
-    /// One register write.
-    async fn write(&mut self, write: Write) -> Result<(), LinkError>;
     /// What the bring-up is doing (a check starts, passes, is skipped): for a program that
     /// shows its progress. Does nothing unless implemented.
-    fn note(&mut self, note: crate::Note) {
+    fn note(&mut self, note: Note) {
         let _ = note;
     }
 }
 
-/// The blocking driver as a [`Link`] (feature `blocking`; the clock is copied: it must be a
-/// handle, as a SysTick counter or `embassy_time` are). `K` is the driver's core: the 2020
-/// one by default, [`v1::DriverCore`](chassis_protocol::driver::v1::DriverCore) for a
-/// [`LinkV1`](crate::v1::LinkV1).
+/// A firmware generation's driver core, as the wrappers make it from a [`Config`]:
+/// [`DriverCore`] (2020) and `driver::v1::DriverCore` (v1.0.0). Sealed.
+pub trait Generation: Core + sealed::Sealed {
+    /// A new core with `config` (what the driver's own constructor makes).
+    fn with_config(config: Config) -> Self;
+}
+
+impl Generation for DriverCore {
+    fn with_config(config: Config) -> Self {
+        DriverCore::new(config)
+    }
+}
+
+impl Generation for chassis_protocol::driver::v1::DriverCore {
+    fn with_config(config: Config) -> Self {
+        chassis_protocol::driver::v1::DriverCore::new(config)
+    }
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for chassis_protocol::driver::DriverCore {}
+    impl Sealed for chassis_protocol::driver::v1::DriverCore {}
+}
+
+/// The blocking driver under a bring-up (feature `blocking`; the clock is copied: it must be
+/// a handle, as a SysTick counter or `embassy_time` are). `K` is the driver's core: each
+/// generation names this wrapper over its own ([`v2020::Blocking`](crate::v2020::Blocking),
+/// [`v1::Blocking`](crate::v1::Blocking)).
 #[cfg(feature = "blocking")]
-pub struct Blocking<U, C, K = DriverCore> {
+pub struct Blocking<U, C, K> {
     pub(crate) driver: chassis_protocol::driver::blocking::Driver<U, C, K>,
     pub(crate) clock: C,
 }
 
 #[cfg(feature = "blocking")]
-impl<U, C> Blocking<U, C>
+impl<U, C, K> Blocking<U, C, K>
 where
     U: embedded_io::Read + embedded_io::Write + embedded_io::ReadReady,
     C: Clock + Clone,
+    K: Generation,
 {
-    /// Wraps a new blocking driver for the 2020 firmware over `uart`.
-    pub fn new(uart: U, clock: C, config: chassis_protocol::driver::Config) -> Self {
-        let driver = chassis_protocol::driver::blocking::Driver::new(uart, clock.clone(), config);
-        Blocking { driver, clock }
-    }
-}
-
-#[cfg(feature = "blocking")]
-impl<U, C> Blocking<U, C, chassis_protocol::driver::v1::DriverCore>
-where
-    U: embedded_io::Read + embedded_io::Write + embedded_io::ReadReady,
-    C: Clock + Clone,
-{
-    /// Wraps a new blocking driver for the v1.0.0 firmware over `uart` (its failsafe at least
+    /// Wraps a new blocking driver for `K`'s generation over `uart` (the v1.0.0 driver's
+    /// failsafe at least
     /// [`MIN_FAILSAFE_MS`](chassis_protocol::driver::v1::MIN_FAILSAFE_MS)).
-    pub fn new_v1(uart: U, clock: C, config: chassis_protocol::driver::Config) -> Self {
+    pub fn new(uart: U, clock: C, config: Config) -> Self {
+        let core = K::with_config(config);
         let driver =
-            chassis_protocol::driver::blocking::Driver::new_v1(uart, clock.clone(), config);
+            chassis_protocol::driver::blocking::Driver::from_core(uart, clock.clone(), core);
         Blocking { driver, clock }
     }
 }
@@ -122,85 +133,52 @@ impl<U, C, K> Blocking<U, C, K> {
 
 #[cfg(feature = "blocking")]
 #[maybe_async::sync_impl]
-impl<U, C> Link for Blocking<U, C>
+impl<U, C, K> Common for Blocking<U, C, K>
 where
     U: embedded_io::Read + embedded_io::Write + embedded_io::ReadReady,
     C: Clock + Clone,
+    K: Core,
 {
+    type Core = K;
+    type Event = K::Event;
     fn now_ms(&mut self) -> u64 {
         self.clock.now_ms()
     }
-    fn core(&self) -> &DriverCore {
+    fn core(&self) -> &K {
         self.driver.core()
     }
-    fn poll(&mut self) -> Result<Option<Event>, LinkError> {
+    fn poll(&mut self) -> Result<Option<K::Event>, LinkError> {
         self.driver.poll().map_err(kind)
-    }
-    fn set_velocity(&mut self, velocity: Velocity) -> Result<(), LinkError> {
-        self.driver.set_velocity(velocity).map_err(kind)
     }
     fn stop(&mut self) -> Result<(), LinkError> {
         self.driver.stop().map_err(kind)
     }
-    fn turn(&mut self, turn: Turn) -> Result<(), LinkError> {
-        self.driver.turn(turn).map_err(kind)
-    }
-    fn turn_remaining(&mut self) -> Result<i32, LinkError> {
-        self.driver.turn_remaining().map_err(kind)
-    }
-    fn read_settings(&mut self) -> Result<Snapshot, LinkError> {
-        self.driver.read_settings().map_err(kind)
-    }
-    fn read_verified(&mut self, register: Register) -> Result<u32, LinkError> {
-        match self
-            .driver
-            .run(Request::ReadVerified(register))
-            .map_err(kind)?
-        {
-            Outcome::Value(v) => Ok(v),
-            _ => Err(Error::Core(CoreError::Unconfirmed(register))),
-        }
-    }
-    fn write(&mut self, write: Write) -> Result<(), LinkError> {
-        self.driver.write(write).map_err(kind)
-    }
 }
 
-/// The async driver as a [`Link`] (feature `async`). `K` is the driver's core: the 2020 one
-/// by default, [`v1::DriverCore`](chassis_protocol::driver::v1::DriverCore) for a
-/// [`LinkV1`](crate::v1::LinkV1).
+/// The async driver under a bring-up (feature `async`). `K` is the driver's core: each
+/// generation names this wrapper over its own ([`v2020::Async`](crate::v2020::Async),
+/// [`v1::Async`](crate::v1::Async)).
 #[cfg(feature = "async")]
-pub struct Async<U, C, D, K = DriverCore> {
+pub struct Async<U, C, D, K> {
     pub(crate) driver: chassis_protocol::driver::asynch::Driver<U, C, D, K>,
     pub(crate) clock: C,
 }
 
 #[cfg(feature = "async")]
-impl<U, C, D> Async<U, C, D>
+impl<U, C, D, K> Async<U, C, D, K>
 where
     U: embedded_io_async::Read + embedded_io_async::Write,
     C: Clock + Clone,
     D: embedded_hal_async::delay::DelayNs,
+    K: Generation,
 {
-    /// Wraps a new async driver for the 2020 firmware over `uart`.
-    pub fn new(uart: U, clock: C, delay: D, config: chassis_protocol::driver::Config) -> Self {
+    /// Wraps a new async driver for `K`'s generation over `uart` (the v1.0.0 driver's
+    /// failsafe at least
+    /// [`MIN_FAILSAFE_MS`](chassis_protocol::driver::v1::MIN_FAILSAFE_MS)).
+    pub fn new(uart: U, clock: C, delay: D, config: Config) -> Self {
+        let core = K::with_config(config);
         let driver =
-            chassis_protocol::driver::asynch::Driver::new(uart, clock.clone(), delay, config);
-        Async { driver, clock }
-    }
-}
-
-#[cfg(feature = "async")]
-impl<U, C, D> Async<U, C, D, chassis_protocol::driver::v1::DriverCore>
-where
-    U: embedded_io_async::Read + embedded_io_async::Write,
-    C: Clock + Clone,
-    D: embedded_hal_async::delay::DelayNs,
-{
-    /// Wraps a new async driver for the v1.0.0 firmware over `uart`.
-    pub fn new_v1(uart: U, clock: C, delay: D, config: chassis_protocol::driver::Config) -> Self {
-        let driver =
-            chassis_protocol::driver::asynch::Driver::new_v1(uart, clock.clone(), delay, config);
+            chassis_protocol::driver::asynch::Driver::from_core(uart, clock.clone(), delay, core);
         Async { driver, clock }
     }
 }
@@ -215,48 +193,52 @@ impl<U, C, D, K> Async<U, C, D, K> {
 
 #[cfg(feature = "async")]
 #[maybe_async::async_impl(AFIT)]
-impl<U, C, D> Link for Async<U, C, D>
+impl<U, C, D, K> Common for Async<U, C, D, K>
 where
     U: embedded_io_async::Read + embedded_io_async::Write,
     C: Clock + Clone,
     D: embedded_hal_async::delay::DelayNs,
+    K: Core,
 {
+    type Core = K;
+    type Event = K::Event;
     fn now_ms(&mut self) -> u64 {
         self.clock.now_ms()
     }
-    fn core(&self) -> &DriverCore {
+    fn core(&self) -> &K {
         self.driver.core()
     }
-    async fn poll(&mut self) -> Result<Option<Event>, LinkError> {
+    async fn poll(&mut self) -> Result<Option<K::Event>, LinkError> {
         self.driver.poll().await.map_err(kind)
-    }
-    async fn set_velocity(&mut self, velocity: Velocity) -> Result<(), LinkError> {
-        self.driver.set_velocity(velocity).await.map_err(kind)
     }
     async fn stop(&mut self) -> Result<(), LinkError> {
         self.driver.stop().await.map_err(kind)
     }
-    async fn turn(&mut self, turn: Turn) -> Result<(), LinkError> {
-        self.driver.turn(turn).await.map_err(kind)
-    }
-    async fn turn_remaining(&mut self) -> Result<i32, LinkError> {
-        self.driver.turn_remaining().await.map_err(kind)
-    }
-    async fn read_settings(&mut self) -> Result<Snapshot, LinkError> {
-        self.driver.read_settings().await.map_err(kind)
-    }
-    async fn read_verified(&mut self, register: Register) -> Result<u32, LinkError> {
-        match self
-            .driver
-            .run(Request::ReadVerified(register))
-            .await
-            .map_err(kind)?
-        {
-            Outcome::Value(v) => Ok(v),
-            _ => Err(Error::Core(CoreError::Unconfirmed(register))),
+}
+
+/// Takes telemetry in for `ms`, every event to `take`; how long that took, ms.
+#[maybe_async::maybe_async]
+pub(crate) async fn listen<L: Common>(
+    link: &mut L,
+    ms: u64,
+    mut take: impl FnMut(L::Event),
+) -> Result<u64, LinkError> {
+    let start = link.now_ms();
+    while link.now_ms().saturating_sub(start) < ms {
+        if let Some(event) = link.poll().await? {
+            take(event);
         }
     }
-    async fn write(&mut self, write: Write) -> Result<(), LinkError> {
-        self.driver.write(write).await.map_err(kind)
+    Ok(link.now_ms().saturating_sub(start))
+}
+
+/// What a board on real hardware does once its bring-up is over: reads telemetry for ever
+/// (the chassis stopped, so the failsafe has nothing to do).
+#[maybe_async::maybe_async]
+pub(crate) async fn park<L: Common>(link: &mut L) -> ! {
+    loop {
+        if let Err(e) = link.poll().await {
+            log!(warn, "link: {}", e);
+        }
     }
 }

@@ -3,9 +3,9 @@
 //! how it fails. The same bring-up runs in QEMU against the board served over TCP
 //! (`tests/qemu.rs`, the `v1_` tests).
 
-use chassis_bringup::link::Blocking;
-use chassis_bringup::v1::{LinkV1, WhyV1, bring_up_v1};
-use chassis_bringup::{Check, LinkError, Note, Plan, Skip};
+use chassis_bringup::link::Common;
+use chassis_bringup::v1::{Blocking, Link, Plan, Why, bring_up};
+use chassis_bringup::{Check, LinkError, Note, Skip, Timing};
 use chassis_protocol::driver::Config;
 use chassis_protocol::driver::v1::{DriverCore, Event};
 use chassis_protocol::sim::v1::{Board, SimConfig};
@@ -16,7 +16,7 @@ use core::cell::Cell;
 /// The forced stop as PROTOCOL-V1.md gives it: `0x25`, ten `00`, BCC `7B ^ 25 = 5E`.
 const FORCED_STOP: [u8; 14] = [0x7B, 0x25, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x5E, 0x7D];
 
-type Inner<'t> = Blocking<SimUart<'t, Board>, SimClock<'t>, DriverCore>;
+type Inner<'t> = Blocking<SimUart<'t, Board>, SimClock<'t>>;
 
 /// The blocking v1.0.0 link over the simulated board, which notes what the bring-up says and
 /// can silence the board when a check starts.
@@ -26,7 +26,9 @@ struct Recording<'t> {
     silence_at: Option<Check>,
 }
 
-impl LinkV1 for Recording<'_> {
+impl Common for Recording<'_> {
+    type Core = DriverCore;
+    type Event = Event;
     fn now_ms(&mut self) -> u64 {
         self.inner.now_ms()
     }
@@ -36,14 +38,8 @@ impl LinkV1 for Recording<'_> {
     fn poll(&mut self) -> Result<Option<Event>, LinkError> {
         self.inner.poll()
     }
-    fn set_velocity(&mut self, velocity: BodyVelocity) -> Result<(), LinkError> {
-        self.inner.set_velocity(velocity)
-    }
     fn stop(&mut self) -> Result<(), LinkError> {
         self.inner.stop()
-    }
-    fn readback(&mut self, readback: Readback) -> Result<Reply, LinkError> {
-        self.inner.readback(readback)
     }
     fn note(&mut self, note: Note) {
         if matches!(note, Note::Start(c) if Some(c) == self.silence_at) {
@@ -61,10 +57,19 @@ impl LinkV1 for Recording<'_> {
     }
 }
 
+impl Link for Recording<'_> {
+    fn set_velocity(&mut self, velocity: BodyVelocity) -> Result<(), LinkError> {
+        self.inner.set_velocity(velocity)
+    }
+    fn readback(&mut self, readback: Readback) -> Result<Reply, LinkError> {
+        self.inner.readback(readback)
+    }
+}
+
 fn link(time: &Cell<u64>, silence_at: Option<Check>) -> Recording<'_> {
     let board = Board::new(SimConfig::default());
     Recording {
-        inner: Blocking::new_v1(SimUart::new(board, time), SimClock(time), Config::DEFAULT),
+        inner: Blocking::new(SimUart::new(board, time), SimClock(time), Config::DEFAULT),
         notes: Vec::new(),
         silence_at,
     }
@@ -85,7 +90,7 @@ fn is_motion(command: &Command) -> bool {
 fn the_bring_up_passes_on_the_simulated_board_and_ends_with_the_forced_stop() {
     let time = Cell::new(0);
     let mut link = link(&time, None);
-    let report = bring_up_v1(&mut link, &Plan::DEFAULT).expect("every check passes");
+    let report = bring_up(&mut link, &Plan::DEFAULT).expect("every check passes");
     eprintln!("{report:?} in {} ms", time.get());
 
     assert!(report.telemetry_per_10s >= 200, "{report:?}");
@@ -143,10 +148,10 @@ fn the_bring_up_passes_on_the_simulated_board_and_ends_with_the_forced_stop() {
 fn a_board_silent_in_the_control_loop_is_stopped_by_the_failsafe() {
     let time = Cell::new(0);
     let mut link = link(&time, Some(Check::ControlLoop));
-    let failure = bring_up_v1(&mut link, &Plan::DEFAULT).expect_err("the loop fails");
+    let failure = bring_up(&mut link, &Plan::DEFAULT).expect_err("the loop fails");
     assert_eq!(failure.check, Check::ControlLoop);
     assert_eq!(failure.check.exit_code(), 18);
-    assert_eq!(failure.why, WhyV1::FailsafeStop);
+    assert_eq!(failure.why, Why::FailsafeStop);
     assert_eq!(link.core().failsafe_stops(), 1);
     let board = board(&mut link);
     assert_eq!(board.velocity(), BodyVelocity::FORCED_STOP);
@@ -160,10 +165,10 @@ fn a_board_silent_in_the_control_loop_is_stopped_by_the_failsafe() {
 fn a_board_silent_while_driving_fails_the_forward_check() {
     let time = Cell::new(0);
     let mut link = link(&time, Some(Check::Forward));
-    let failure = bring_up_v1(&mut link, &Plan::DEFAULT).expect_err("forward fails");
+    let failure = bring_up(&mut link, &Plan::DEFAULT).expect_err("forward fails");
     assert_eq!(failure.check, Check::Forward);
     assert!(
-        matches!(failure.why, WhyV1::FailsafeStop | WhyV1::NoTelemetry),
+        matches!(failure.why, Why::FailsafeStop | Why::NoTelemetry),
         "{failure:?}"
     );
     assert_eq!(board(&mut link).velocity(), BodyVelocity::FORCED_STOP);
@@ -177,9 +182,9 @@ fn a_low_battery_fails_its_check_and_the_chassis_is_stopped() {
         min_millivolts: 12_500,
         ..Plan::DEFAULT
     };
-    let failure = bring_up_v1(&mut link, &plan).expect_err("the battery is below 12.5 V");
+    let failure = bring_up(&mut link, &plan).expect_err("the battery is below 12.5 V");
     assert_eq!(failure.check, Check::Battery);
-    assert!(matches!(failure.why, WhyV1::LowBattery(mv, 12_500) if mv <= 12_000));
+    assert!(matches!(failure.why, Why::LowBattery(mv, 12_500) if mv <= 12_000));
     assert_eq!(board(&mut link).velocity(), BodyVelocity::FORCED_STOP);
 }
 
@@ -188,10 +193,13 @@ fn without_motion_only_readbacks_are_sent() {
     let time = Cell::new(0);
     let mut link = link(&time, None);
     let plan = Plan {
-        motion: false,
+        timing: Timing {
+            motion: false,
+            ..Timing::DEFAULT
+        },
         ..Plan::DEFAULT
     };
-    bring_up_v1(&mut link, &plan).expect("link, settings and battery pass");
+    bring_up(&mut link, &plan).expect("link, settings and battery pass");
     assert!(
         link.notes
             .contains(&Note::Skipped(Check::Forward, Skip::NoMotion))

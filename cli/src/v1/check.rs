@@ -1,5 +1,5 @@
 //! `chassis check` on a board running the v1.0.0 firmware: its bring-up
-//! ([`chassis_bringup::v1::bring_up_v1`], the code the QEMU firmware runs against a v1.0.0
+//! ([`chassis_bringup::v1::bring_up`], the code the QEMU firmware runs against a v1.0.0
 //! board) from a PC, through the host driver. The same shape as the 2020 check: a progress line
 //! per check, a verdict on one screen, the exit status the failed check's code (the QEMU
 //! firmware's), a question before anything moves, and SIGINT, SIGTERM and SIGHUP ending the
@@ -12,8 +12,9 @@
 use crate::check::{Ending, Session, ending, not_run, stopped_words};
 use crate::port;
 use crate::stopping::core_words;
-use chassis_bringup::v1::{LinkV1, ReportV1, WhyV1, bring_up_v1};
-use chassis_bringup::{Check, Failure, LinkError, Note, Plan, Skip};
+use chassis_bringup::link::Common;
+use chassis_bringup::v1::{Failure, Link, Plan, Report, Why, bring_up};
+use chassis_bringup::{Check, LinkError, Note, Skip, Timing};
 use chassis_protocol::driver::Error;
 use chassis_protocol::driver::host::Heard;
 use chassis_protocol::driver::v1::{DriverCore, Event};
@@ -38,18 +39,31 @@ const fn name(check: Check) -> &'static str {
     }
 }
 
-/// The check's [`LinkV1`]: the host driver, with a progress line per check and an ending (a
+/// The check's [`Link`]: the host driver, with a progress line per check and an ending (a
 /// signal, the terminal or input gone: [`crate::ending`]) turned into an error at the next
 /// call (the bring-up then sends the forced stop itself). A check done keeps whether it passed
 /// (`false`: skipped).
-type CheckerV1 = Session<DriverCore, bool>;
+type Checker = Session<DriverCore, bool>;
 
-impl LinkV1 for CheckerV1 {
+impl Link for Checker {
+    fn set_velocity(&mut self, velocity: BodyVelocity) -> Result<(), LinkError> {
+        self.go_on()?;
+        self.inner.set_velocity(velocity)
+    }
+    fn readback(&mut self, readback: Readback) -> Result<Reply, LinkError> {
+        self.go_on()?;
+        self.inner.readback(readback)
+    }
+}
+
+impl Common for Checker {
+    type Core = DriverCore;
+    type Event = Event;
     fn now_ms(&mut self) -> u64 {
         self.inner.now_ms()
     }
     fn core(&self) -> &DriverCore {
-        LinkV1::core(&self.inner)
+        Common::core(&self.inner)
     }
     fn poll(&mut self) -> Result<Option<Event>, LinkError> {
         self.go_on()?;
@@ -59,16 +73,8 @@ impl LinkV1 for CheckerV1 {
         }
         Ok(event)
     }
-    fn set_velocity(&mut self, velocity: BodyVelocity) -> Result<(), LinkError> {
-        self.go_on()?;
-        self.inner.set_velocity(velocity)
-    }
     fn stop(&mut self) -> Result<(), LinkError> {
-        Session::stop(self, LinkV1::stop)
-    }
-    fn readback(&mut self, readback: Readback) -> Result<Reply, LinkError> {
-        self.go_on()?;
-        self.inner.readback(readback)
+        Session::stop(self, Common::stop)
     }
     fn note(&mut self, note: Note) {
         let index = |c: Check| checks().position(|x| x == c).unwrap_or(0) + 1;
@@ -84,7 +90,7 @@ impl LinkV1 for CheckerV1 {
                 let seconds = self.step.elapsed().as_secs_f64();
                 let detail = match check {
                     Check::Link => format!("{} telemetry frames in {seconds:.1} s", self.frames),
-                    Check::Battery => LinkV1::core(&self.inner)
+                    Check::Battery => Common::core(&self.inner)
                         .telemetry()
                         .map_or_else(String::new, |t| {
                             format!("{:.2} V", units(t.value.battery_mv.into()))
@@ -121,56 +127,54 @@ fn units(milli: i32) -> f64 {
 }
 
 /// Why a check failed, in words.
-fn why(why: WhyV1, heard: Heard, port: &str) -> String {
+fn why(why: Why, heard: Heard, port: &str) -> String {
     match why {
-        WhyV1::Driver(Error::Transport(embedded_io::ErrorKind::Interrupted)) => {
-            "interrupted".into()
-        }
-        WhyV1::Driver(Error::Core(e)) => core_words(e, heard, port),
-        WhyV1::Driver(Error::Transport(kind)) => format!(
+        Why::Driver(Error::Transport(embedded_io::ErrorKind::Interrupted)) => "interrupted".into(),
+        Why::Driver(Error::Core(e)) => core_words(e, heard, port),
+        Why::Driver(Error::Transport(kind)) => format!(
             "the serial port failed ({kind:?}): was the adapter unplugged, or the board's power cut?"
         ),
-        WhyV1::Driver(e) => format!("the driver failed: {e:?}"),
-        WhyV1::Rate(per_10s) if heard == Heard::Nothing => format!(
+        Why::Driver(e) => format!("the driver failed: {e:?}"),
+        Why::Rate(per_10s) if heard == Heard::Nothing => format!(
             "no telemetry ({:.1} Hz): is the board powered, TX wired to RX and RX to TX, at 115200 bps?",
             f64::from(per_10s) / 10.0
         ),
-        WhyV1::Rate(per_10s) => format!(
+        Why::Rate(per_10s) => format!(
             "telemetry comes at {:.1} Hz, at least 14 Hz expected (the board sends 20-24 Hz)",
             f64::from(per_10s) / 10.0
         ),
-        WhyV1::NoTelemetry => {
+        Why::NoTelemetry => {
             "no telemetry frame came when one was needed: the board went quiet".into()
         }
-        WhyV1::NotFollowed(commanded, measured) => format!(
+        Why::NotFollowed(commanded, measured) => format!(
             "the measured velocity did not follow the command: {:.3} m/s for {:.3} m/s commanded (motors powered? wheels free?)",
             units(measured.into()),
             units(commanded.into())
         ),
-        WhyV1::YawOff(expected, measured) => format!(
+        Why::YawOff(expected, measured) => format!(
             "the yaw from the IMU turned {:.2} rad, {:.2} rad expected (is the chassis free to turn, the IMU fixed to it?)",
             units(measured),
             units(expected)
         ),
-        WhyV1::StillMoving([vx, vy, wz]) => format!(
+        Why::StillMoving([vx, vy, wz]) => format!(
             "still moving after the forced stop: |vx| {:.3} m/s, |vy| {:.3} m/s, |wz| {:.3} rad/s",
             units(vx.into()),
             units(vy.into()),
             units(wz.into())
         ),
-        WhyV1::LowBattery(mv, cutoff) => format!(
+        Why::LowBattery(mv, cutoff) => format!(
             "the battery is at {:.2} V, its cut-off {:.2} V: charge it",
             units(mv.into()),
             units(cutoff.into())
         ),
-        WhyV1::FailsafeStop => {
+        Why::FailsafeStop => {
             "the board went quiet: the driver's failsafe sent the forced stop".into()
         }
     }
 }
 
 /// The verdict of a passed check, one line per check.
-fn verdict(report: &ReportV1, done: &[(Check, bool)], motion: bool, seconds: f64) -> String {
+fn verdict(report: &Report, done: &[(Check, bool)], motion: bool, seconds: f64) -> String {
     let passed = done.iter().filter(|(_, p)| *p).count();
     let skipped = done.len() - passed;
     let mut lines = vec![format!(
@@ -202,7 +206,7 @@ fn verdict(report: &ReportV1, done: &[(Check, bool)], motion: bool, seconds: f64
 }
 
 /// What a passed check found, for its line of the verdict.
-fn passed_detail(check: Check, report: &ReportV1) -> String {
+fn passed_detail(check: Check, report: &Report) -> String {
     let (system, geometry, pid) = (&report.system, &report.geometry, &report.pid);
     match check {
         Check::Link => format!(
@@ -250,7 +254,7 @@ fn passed_detail(check: Check, report: &ReportV1) -> String {
 
 /// `chassis check [--no-motion] [--yes]` on a v1.0.0 board.
 pub fn check(path: &str, no_motion: bool, yes: bool) -> Result<(), (String, u8)> {
-    let mut link = CheckerV1::open(path, no_motion, yes, MOTION, |path| {
+    let mut link = Checker::open(path, no_motion, yes, MOTION, |path| {
         port::open_v1(path, None)
     })?;
     say!(
@@ -262,11 +266,13 @@ pub fn check(path: &str, no_motion: bool, yes: bool) -> Result<(), (String, u8)>
         }
     );
     let plan = Plan {
-        drive: None,
-        motion: !no_motion,
+        timing: Timing {
+            motion: !no_motion,
+            ..Timing::DEFAULT
+        },
         ..Plan::DEFAULT
     };
-    let result = bring_up_v1(&mut link, &plan);
+    let result = bring_up(&mut link, &plan);
     let seconds = link.start.elapsed().as_secs_f64();
     let failure = match result {
         Ok(report) => {
@@ -276,9 +282,9 @@ pub fn check(path: &str, no_motion: bool, yes: bool) -> Result<(), (String, u8)>
         Err(failure) => failure,
     };
     let now = link.now_ms();
-    let heard = LinkV1::core(&link).heard(now);
+    let heard = Common::core(&link).heard(now);
     let stopped = stopped_words(link.last_stop, no_motion, true, |e| {
-        why(WhyV1::Driver(e), heard, path)
+        why(Why::Driver(e), heard, path)
     });
     let Failure { check, why: reason } = failure;
     Err(ending(Ending {

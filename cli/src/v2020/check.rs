@@ -1,4 +1,4 @@
-//! `chassis check`: the firmware's bring-up ([`chassis_bringup::bring_up`], the same code the
+//! `chassis check`: the firmware's bring-up ([`chassis_bringup::v2020::bring_up`], the same code the
 //! boards under `mcu-example/boards/` run) from a PC, through the host driver: a progress line
 //! per check, a verdict on one screen, the exit status the verdict (0, or the failed check's
 //! code: the QEMU firmware's). `--no-motion` runs only what neither moves the chassis nor
@@ -8,7 +8,9 @@
 use super::open;
 use crate::check::{Ending, Session, ending, not_run, stopped_words};
 use crate::stopping::core_words;
-use chassis_bringup::{Check, Failure, Link, LinkError, Note, Plan, Report, Skip, Why, bring_up};
+use chassis_bringup::link::Common;
+use chassis_bringup::v2020::{Failure, Link, Plan, Report, Why, bring_up};
+use chassis_bringup::{Check, LinkError, Note, Skip, Timing};
 use chassis_protocol::driver::host::Heard;
 use chassis_protocol::driver::{DriverCore, Error, Event};
 use chassis_protocol::registers::Snapshot;
@@ -53,27 +55,14 @@ impl Checker {
     }
 
     fn inner_core(&self) -> &DriverCore {
-        Link::core(&self.inner)
+        Common::core(&self.inner)
     }
 }
 
 impl Link for Checker {
-    fn now_ms(&mut self) -> u64 {
-        self.inner.now_ms()
-    }
-    fn core(&self) -> &DriverCore {
-        self.inner_core()
-    }
-    fn poll(&mut self) -> Result<Option<Event>, LinkError> {
-        self.go_on()?;
-        self.inner.poll()
-    }
     fn set_velocity(&mut self, velocity: Velocity) -> Result<(), LinkError> {
         self.go_on()?;
         self.inner.set_velocity(velocity)
-    }
-    fn stop(&mut self) -> Result<(), LinkError> {
-        Session::stop(self, |link| link.stop())
     }
     fn turn(&mut self, turn: Turn) -> Result<(), LinkError> {
         self.go_on()?;
@@ -94,6 +83,24 @@ impl Link for Checker {
     fn write(&mut self, write: Write) -> Result<(), LinkError> {
         self.go_on()?;
         self.inner.write(write)
+    }
+}
+
+impl Common for Checker {
+    type Core = DriverCore;
+    type Event = Event;
+    fn now_ms(&mut self) -> u64 {
+        self.inner.now_ms()
+    }
+    fn core(&self) -> &DriverCore {
+        self.inner_core()
+    }
+    fn poll(&mut self) -> Result<Option<Event>, LinkError> {
+        self.go_on()?;
+        self.inner.poll()
+    }
+    fn stop(&mut self) -> Result<(), LinkError> {
+        Session::stop(self, Common::stop)
     }
     fn note(&mut self, note: Note) {
         let index = |c: Check| Check::ALL.iter().position(|x| *x == c).unwrap_or(0) + 1;
@@ -267,8 +274,11 @@ pub fn check(
         }
     );
     let plan = Plan {
+        timing: Timing {
+            motion: !no_motion,
+            ..Timing::DEFAULT
+        },
         drive,
-        motion: !no_motion,
         ..Plan::DEFAULT
     };
     let result = bring_up(&mut link, &plan);

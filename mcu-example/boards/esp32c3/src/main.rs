@@ -21,7 +21,7 @@
 #![no_std]
 #![no_main]
 
-use chassis_bringup::{Plan, bring_up_and_park, link::Blocking};
+use chassis_bringup::v2020::{Blocking, Plan, bring_up_and_park};
 use chassis_protocol::driver::Config;
 use esp_hal::clock::CpuClock;
 use esp_hal::time::Instant;

@@ -1,6 +1,7 @@
 //! The bring-up on an nRF52840 (nRF52840-DK, Cortex-M4F) with embassy: UARTE0 as a
 //! `BufferedUarte` (P1.02 TX, P1.01 RX, 115 200 8N1) through the async driver, defmt over RTT.
-//! The same bring-up as every board (`chassis_bringup::bring_up`); this file is only the glue.
+//! The same 2020 bring-up as every board (`chassis_bringup::v2020::bring_up`); this file is only
+//! the glue.
 //!
 //! embassy-nrf's `BufferedUarte` receives by EasyDMA into its ring buffer, counting bytes with
 //! TIMER1 through two PPI channels (hence the timer and PPI arguments), so a read is served from
@@ -14,7 +15,8 @@
 #![no_std]
 #![no_main]
 
-use chassis_bringup::{Plan, bring_up_and_park, embassy::Millis, link::Async};
+use chassis_bringup::embassy::Millis;
+use chassis_bringup::v2020::{Async, Plan, bring_up_and_park};
 use chassis_protocol::driver::Config;
 use embassy_executor::Spawner;
 use embassy_nrf::buffered_uarte::{self, BufferedUarte};

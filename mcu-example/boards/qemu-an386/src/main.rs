@@ -5,9 +5,9 @@
 //! It first finds which firmware the board runs (`chassis_protocol::detect::detect`: it
 //! listens, and probes only a quiet line), logs it, then runs that generation's bring-up:
 //!
-//! * **2020** (`FF FE` frames): [`bring_up`] over the 2020 blocking driver (the encoders count,
-//!   one 90° turn sent once, the drive type, register reads while moving).
-//! * **v1.0.0** (`7B … BCC 7D` frames): [`bring_up_v1`] over the v1.0.0 blocking driver (the
+//! * **2020** (`FF FE` frames): [`v2020::bring_up`] over the 2020 blocking driver (the encoders
+//!   count, one 90° turn sent once, the drive type, register reads while moving).
+//! * **v1.0.0** (`7B … BCC 7D` frames): [`v1::bring_up`] over the v1.0.0 blocking driver (the
 //!   measured velocity follows, a rotation at a rate turns the quaternion's yaw, the forced
 //!   stop; nothing written).
 //!
@@ -20,8 +20,7 @@
 #![no_main]
 
 use board_qemu_an386::{stack, time, uart::Uart0};
-use chassis_bringup::v1::{ReportV1, bring_up_v1};
-use chassis_bringup::{Check, Plan, Report, bring_up, link::Blocking};
+use chassis_bringup::{Check, v1, v2020};
 use chassis_protocol::detect::{Firmware, detect};
 use chassis_protocol::driver::Config;
 use cortex_m_rt::entry;
@@ -107,8 +106,8 @@ fn firmware(uart: &mut Uart0) -> Result<Firmware, i32> {
 
 /// The 2020 bring-up; its exit code.
 fn v2020(uart: Uart0) -> i32 {
-    let mut link = Blocking::new(uart, time::Millis, CONFIG);
-    match bring_up(&mut link, &Plan::DEFAULT) {
+    let mut link = v2020::Blocking::new(uart, time::Millis, CONFIG);
+    match v2020::bring_up(&mut link, &v2020::Plan::DEFAULT) {
         Ok(report) => {
             log_report(&report);
             0
@@ -122,8 +121,8 @@ fn v2020(uart: Uart0) -> i32 {
 
 /// The v1.0.0 bring-up; its exit code.
 fn v1_0_0(uart: Uart0) -> i32 {
-    let mut link = Blocking::new_v1(uart, time::Millis, CONFIG);
-    match bring_up_v1(&mut link, &Plan::DEFAULT) {
+    let mut link = v1::Blocking::new(uart, time::Millis, CONFIG);
+    match v1::bring_up(&mut link, &v1::Plan::DEFAULT) {
         Ok(report) => {
             log_report_v1(&report);
             0
@@ -135,11 +134,11 @@ fn v1_0_0(uart: Uart0) -> i32 {
     }
 }
 
-fn log_report(report: &Report) {
+fn log_report(report: &v2020::Report) {
     defmt::info!("PASS: every check passed: {}", report);
 }
 
-fn log_report_v1(report: &ReportV1) {
+fn log_report_v1(report: &v1::Report) {
     defmt::info!("PASS: every check passed (v1.0.0): {}", report);
 }
 

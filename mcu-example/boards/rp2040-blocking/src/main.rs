@@ -6,7 +6,7 @@
 #![no_std]
 #![no_main]
 
-use chassis_bringup::{Plan, bring_up_and_park, link::Blocking};
+use chassis_bringup::v2020::{Blocking, Plan, bring_up_and_park};
 use chassis_protocol::driver::{Config, nb::NbSerial};
 use rp2040_hal::fugit::RateExtU32;
 use rp2040_hal::uart::{DataBits, StopBits, UartConfig, UartPeripheral};

@@ -1,11 +1,13 @@
 //! The bring-up on a Raspberry Pi Pico (RP2040, Cortex-M0+) with embassy: UART0 as a
 //! `BufferedUart` (GP0 TX, GP1 RX, 115 200 8N1) through the async driver, defmt over RTT.
-//! The same bring-up as every board (`chassis_bringup::bring_up`); this file is only the glue.
+//! The same 2020 bring-up as every board (`chassis_bringup::v2020::bring_up`); this file is only
+//! the glue.
 
 #![no_std]
 #![no_main]
 
-use chassis_bringup::{Plan, bring_up_and_park, embassy::Millis, link::Async};
+use chassis_bringup::embassy::Millis;
+use chassis_bringup::v2020::{Async, Plan, bring_up_and_park};
 use chassis_protocol::driver::Config;
 use embassy_executor::Spawner;
 use embassy_rp::bind_interrupts;

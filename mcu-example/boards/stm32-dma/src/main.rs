@@ -3,8 +3,8 @@
 //! DMA buffer (`RingBufferedUartRx`, DMA2 stream 2) that the CPU never touches byte by byte,
 //! and the bytes go to the driver's sans-IO core a slice at a time (`DriverCore::receive`: the
 //! parser's slice path, 3.5× faster than its byte path in the peer benchmark). The same
-//! bring-up as every board (`chassis_bringup::bring_up`), over [`DmaLink`], a `Link` written
-//! here on the core.
+//! bring-up as every board (`chassis_bringup::v2020::bring_up`), over [`DmaLink`], a `Link`
+//! written here on the core.
 //!
 //! # Why the core, not a shell
 //!
@@ -38,7 +38,9 @@
 #![no_std]
 #![no_main]
 
-use chassis_bringup::{Link, LinkError, Plan, bring_up_and_park};
+use chassis_bringup::LinkError;
+use chassis_bringup::link::Common;
+use chassis_bringup::v2020::{Link, Plan, bring_up_and_park};
 use chassis_protocol::driver::asynch::{MAX_WAIT_MS, STALL_WAITS};
 use chassis_protocol::driver::{
     Config, CoreError, DriverCore, Error, Event, Outcome, Readable, Request, TurnState, reg,
@@ -235,7 +237,9 @@ impl<'d> DmaLink<'d> {
     }
 }
 
-impl Link for DmaLink<'_> {
+impl Common for DmaLink<'_> {
+    type Core = DriverCore;
+    type Event = Event;
     fn now_ms(&mut self) -> u64 {
         now_ms()
     }
@@ -249,9 +253,6 @@ impl Link for DmaLink<'_> {
         }
         result.map(|(event, _)| event)
     }
-    async fn set_velocity(&mut self, velocity: Velocity) -> Result<(), LinkError> {
-        self.send(|core, now| core.velocity(velocity, now))
-    }
     async fn stop(&mut self) -> Result<(), LinkError> {
         self.core.stop();
         self.flush_out(now_ms())?;
@@ -261,6 +262,12 @@ impl Link for DmaLink<'_> {
         } else {
             Ok(())
         }
+    }
+}
+
+impl Link for DmaLink<'_> {
+    async fn set_velocity(&mut self, velocity: Velocity) -> Result<(), LinkError> {
+        self.send(|core, now| core.velocity(velocity, now))
     }
     async fn turn(&mut self, turn: Turn) -> Result<(), LinkError> {
         if self.core.turn_state() == TurnState::Unknown {

@@ -1,11 +1,13 @@
 //! The bring-up on an STM32F411 (Nucleo-F411RE, Black Pill) with embassy: USART1 as a
 //! `BufferedUart` (PA9 TX, PA10 RX, 115 200 8N1) through the async driver, defmt over RTT.
-//! The same bring-up as every board (`chassis_bringup::bring_up`); this file is only the glue.
+//! The same 2020 bring-up as every board (`chassis_bringup::v2020::bring_up`); this file is only
+//! the glue.
 
 #![no_std]
 #![no_main]
 
-use chassis_bringup::{Plan, bring_up_and_park, embassy::Millis, link::Async};
+use chassis_bringup::embassy::Millis;
+use chassis_bringup::v2020::{Async, Plan, bring_up_and_park};
 use chassis_protocol::driver::Config;
 use embassy_executor::Spawner;
 use embassy_stm32::usart::{self, BufferedUart};
