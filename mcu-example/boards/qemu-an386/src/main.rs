@@ -11,6 +11,9 @@
 //!   measured velocity follows, a rotation at a rate turns the quaternion's yaw, the forced
 //!   stop; nothing written).
 //!
+//! The generation is decided once, in [`main`]; [`verdict`] logs either bring-up's result the
+//! same way and gives its exit code.
+//!
 //! A silent line is taken as 2020, whose link check then fails (exit 10) saying what did not
 //! come; bytes of neither generation fail the link check at once, with nothing sent.
 //!
@@ -20,7 +23,7 @@
 #![no_main]
 
 use board_qemu_an386::{stack, time, uart::Uart0};
-use chassis_bringup::{Check, v1, v2020};
+use chassis_bringup::{Check, Failure, v1, v2020};
 use chassis_protocol::detect::{Firmware, detect};
 use chassis_protocol::driver::Config;
 use cortex_m_rt::entry;
@@ -50,8 +53,14 @@ fn main() -> ! {
     );
 
     let code = match firmware(&mut uart) {
-        Ok(Firmware::V1_0_0) => v1_0_0(uart),
-        Ok(Firmware::V2020) => v2020(uart),
+        Ok(Firmware::V2020) => {
+            let mut link = v2020::Blocking::new(uart, time::Millis, CONFIG);
+            verdict(v2020::bring_up(&mut link, &v2020::Plan::DEFAULT), "")
+        }
+        Ok(Firmware::V1_0_0) => {
+            let mut link = v1::Blocking::new(uart, time::Millis, CONFIG);
+            verdict(v1::bring_up(&mut link, &v1::Plan::DEFAULT), " (v1.0.0)")
+        }
         Err(code) => code,
     };
     defmt::info!(
@@ -104,12 +113,15 @@ fn firmware(uart: &mut Uart0) -> Result<Firmware, i32> {
     }
 }
 
-/// The 2020 bring-up; its exit code.
-fn v2020(uart: Uart0) -> i32 {
-    let mut link = v2020::Blocking::new(uart, time::Millis, CONFIG);
-    match v2020::bring_up(&mut link, &v2020::Plan::DEFAULT) {
+/// A bring-up's verdict, logged (`generation`: what follows "passed" in the log, the
+/// generation when it is not 2020); its exit code.
+fn verdict<R: defmt::Format, W: defmt::Format>(
+    result: Result<R, Failure<W>>,
+    generation: &str,
+) -> i32 {
+    match result {
         Ok(report) => {
-            log_report(&report);
+            defmt::info!("PASS: every check passed{}: {}", generation, report);
             0
         }
         Err(failure) => {
@@ -117,29 +129,6 @@ fn v2020(uart: Uart0) -> i32 {
             failure.check.exit_code()
         }
     }
-}
-
-/// The v1.0.0 bring-up; its exit code.
-fn v1_0_0(uart: Uart0) -> i32 {
-    let mut link = v1::Blocking::new(uart, time::Millis, CONFIG);
-    match v1::bring_up(&mut link, &v1::Plan::DEFAULT) {
-        Ok(report) => {
-            log_report_v1(&report);
-            0
-        }
-        Err(failure) => {
-            defmt::error!("FAIL: {} ({})", failure.check, failure.why);
-            failure.check.exit_code()
-        }
-    }
-}
-
-fn log_report(report: &v2020::Report) {
-    defmt::info!("PASS: every check passed: {}", report);
-}
-
-fn log_report_v1(report: &v1::Report) {
-    defmt::info!("PASS: every check passed (v1.0.0): {}", report);
 }
 
 #[cfg(not(feature = "no-panic-proof"))]
