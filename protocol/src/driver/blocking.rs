@@ -22,7 +22,7 @@
 //! # Ok::<(), chassis_protocol::driver::Error<core::convert::Infallible>>(())
 //! ```
 
-use super::sans_io::UserFrame;
+use super::v2020::UserFrame;
 use super::{Clock, Config, Core, CoreError, DriverCore, Error, Outcome, Readable, Request, v1};
 use crate::command::{Action, Motors, Register, Turn, Velocity, Write};
 use crate::registers::Snapshot;

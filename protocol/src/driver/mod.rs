@@ -134,18 +134,21 @@ pub mod host;
 #[cfg(feature = "embedded-io-06")]
 #[cfg_attr(docsrs, doc(cfg(feature = "embedded-io-06")))]
 pub mod io06;
+mod latest;
 #[cfg(feature = "nb")]
 #[cfg_attr(docsrs, doc(cfg(feature = "nb")))]
 pub mod nb;
+mod pump;
 mod safety;
-mod sans_io;
 mod split;
 mod time;
 pub mod v1;
+mod v2020;
 
 pub use crate::registers::{BatteryRange, Readable, Snapshot, reg};
-pub use sans_io::{DriverCore, Event, Outcome, Outgoing, Request, Stamped, StreamInfo, TurnState};
+pub use latest::{Stamped, StreamInfo};
 pub use split::Split;
+pub use v2020::{DriverCore, Event, Outcome, Outgoing, Request, TurnState};
 
 use crate::command::Register;
 use core::fmt;

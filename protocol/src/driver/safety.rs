@@ -59,11 +59,8 @@ pub(crate) struct Safety<W: Wire> {
     time: Timebase,
     tx: Option<InFlight<W::Frame>>,
     stop_queued: bool,
-    failsafe_ms: u32,
-    settings_pause_ms: u32,
-    /// The last frame of any kind (telemetry or reply): the board is alive.
-    last_heard_ms: Option<u64>,
-    last_telemetry_ms: Option<u64>,
+    limits: Limits,
+    heard: Heard,
     /// The last settings frame sent (a read's once answered): the board may pause its
     /// telemetry after it.
     settings_sent_ms: Option<u64>,
@@ -79,6 +76,32 @@ pub(crate) struct Safety<W: Wire> {
     stalled_at: Option<u64>,
 }
 
+/// The failsafe's limits, from [`Config`].
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Limits {
+    failsafe_ms: u32,
+    settings_pause_ms: u32,
+}
+
+impl Limits {
+    const fn of(config: &Config) -> Self {
+        Limits {
+            failsafe_ms: config.failsafe_ms,
+            settings_pause_ms: config.settings_pause_ms,
+        }
+    }
+}
+
+/// When the board was last heard.
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Heard {
+    /// The last frame of any kind (telemetry or reply): the board is alive.
+    any_ms: Option<u64>,
+    telemetry_ms: Option<u64>,
+}
+
 impl<W: Wire> Safety<W> {
     /// Nothing sent, nothing heard, the chassis taken as standing still.
     pub(crate) const fn new(config: &Config) -> Self {
@@ -86,10 +109,11 @@ impl<W: Wire> Safety<W> {
             time: Timebase::new(),
             tx: None,
             stop_queued: false,
-            failsafe_ms: config.failsafe_ms,
-            settings_pause_ms: config.settings_pause_ms,
-            last_heard_ms: None,
-            last_telemetry_ms: None,
+            limits: Limits::of(config),
+            heard: Heard {
+                any_ms: None,
+                telemetry_ms: None,
+            },
             settings_sent_ms: None,
             read_sent_low: 0,
             telemetry_after_settings: 0,
@@ -102,8 +126,7 @@ impl<W: Wire> Safety<W> {
 
     /// Takes new limits from `config`; everything else is kept.
     pub(crate) fn set_config(&mut self, config: &Config) {
-        self.failsafe_ms = config.failsafe_ms;
-        self.settings_pause_ms = config.settings_pause_ms;
+        self.limits = Limits::of(config);
     }
 
     // ----- time -----
@@ -235,13 +258,13 @@ impl<W: Wire> Safety<W> {
     // Out of line: telemetry and replies share it (`size_driver`: 24 B).
     #[inline(never)]
     pub(crate) fn heard(&mut self, at_ms: u64) {
-        self.last_heard_ms = Some(self.last_heard_ms.map_or(at_ms, |t| t.max(at_ms)));
+        self.heard.any_ms = Some(self.heard.any_ms.map_or(at_ms, |t| t.max(at_ms)));
     }
 
     /// A telemetry frame was heard at `at_ms`.
     pub(crate) fn telemetry(&mut self, at_ms: u64) {
         self.heard(at_ms);
-        self.last_telemetry_ms = Some(at_ms);
+        self.heard.telemetry_ms = Some(at_ms);
         if self.settings_sent_ms.is_some_and(|sent| at_ms > sent) {
             self.telemetry_after_settings = self.telemetry_after_settings.saturating_add(1);
         }
@@ -272,12 +295,12 @@ impl<W: Wire> Safety<W> {
 
     /// When the last frame of any kind was heard.
     pub(crate) const fn last_heard_ms(&self) -> Option<u64> {
-        self.last_heard_ms
+        self.heard.any_ms
     }
 
     /// When the last telemetry frame was heard.
     pub(crate) const fn last_telemetry_ms(&self) -> Option<u64> {
-        self.last_telemetry_ms
+        self.heard.telemetry_ms
     }
 
     /// Times the failsafe has stopped the chassis.
@@ -287,22 +310,23 @@ impl<W: Wire> Safety<W> {
 
     /// Whether a frame was heard within `failsafe_ms` of `now_ms`.
     pub(crate) fn link_alive(&self, now_ms: u64) -> bool {
-        self.last_heard_ms
-            .is_some_and(|t| now_ms.saturating_sub(t) <= u64::from(self.failsafe_ms))
+        self.heard
+            .any_ms
+            .is_some_and(|t| now_ms.saturating_sub(t) <= u64::from(self.limits.failsafe_ms))
     }
 
     /// When the failsafe falls due, if the chassis is moving.
     pub(crate) fn failsafe_deadline(&self) -> Option<u64> {
         let since = self.moving_since_ms?;
-        let heard = self.last_heard_ms.map_or(since, |t| t.max(since));
-        let silent_until = heard.saturating_add(u64::from(self.failsafe_ms));
+        let heard = self.heard.any_ms.map_or(since, |t| t.max(since));
+        let silent_until = heard.saturating_add(u64::from(self.limits.failsafe_ms));
         // The pause allowance lasts until telemetry is heard again: once the board streams
         // after the settings frame, its pause is over, and silence is silence. Two frames, not
         // one: a frame the board sent just before the pause can come out of the parser after
         // the settings frame went (confirmed by the reply's first byte).
         let paused_until = match self.settings_sent_ms {
             Some(_) if self.telemetry_after_settings >= 2 => 0,
-            Some(sent) => sent.saturating_add(u64::from(self.settings_pause_ms)),
+            Some(sent) => sent.saturating_add(u64::from(self.limits.settings_pause_ms)),
             None => 0,
         };
         Some(silent_until.max(paused_until))
