@@ -177,31 +177,7 @@ where
         (self.uart, self.clock, self.core)
     }
 
-    /// Changes the configuration, keeping everything the driver knows.
-    pub fn set_config(&mut self, config: Config) {
-        self.core.set_config(config);
-    }
-
-    /// The UART (to inspect it; the driver keeps it).
-    pub const fn uart(&self) -> &U {
-        &self.uart
-    }
-
-    /// The UART, mutably (for a test double's controls; do not read from or write to it behind
-    /// the driver's back).
-    pub fn uart_mut(&mut self) -> &mut U {
-        &mut self.uart
-    }
-
-    /// The sans-IO core: latest telemetry, stream rates, parser counters, link state.
-    pub const fn core(&self) -> &K {
-        &self.core
-    }
-
-    /// The sans-IO core, mutably: [`DriverCore::abandon_turn`], [`DriverCore::abort`].
-    pub fn core_mut(&mut self) -> &mut K {
-        &mut self.core
-    }
+    super::shell_accessors!();
 
     /// Stops the chassis (the generation's stop frame: STOP, or v1.0.0's forced stop); on the
     /// 2020 firmware, if a turn is outstanding, cancels it too (reads the angle still pending

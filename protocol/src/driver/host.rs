@@ -266,30 +266,6 @@ impl Heard {
     }
 }
 
-impl super::DriverCore {
-    /// What has come from the board, judged at `now_ms` (for [`words_heard`]).
-    #[must_use]
-    pub fn heard(&self, now_ms: u64) -> Heard {
-        Heard::from_link(
-            self.last_heard_ms(),
-            self.link_alive(now_ms),
-            self.parser_stats().discarded,
-        )
-    }
-}
-
-impl super::v1::DriverCore {
-    /// What has come from the board, judged at `now_ms` (for [`words_heard`]).
-    #[must_use]
-    pub fn heard(&self, now_ms: u64) -> Heard {
-        Heard::from_link(
-            self.last_heard_ms(),
-            self.link_alive(now_ms),
-            self.parser_stats().discarded,
-        )
-    }
-}
-
 /// A driver error in the words of the `chassis` command (and of the Python package), for a
 /// person, told by what has come from the board on `port` ([`Heard`]).
 #[must_use]
@@ -297,7 +273,7 @@ pub fn words_heard(e: super::CoreError, heard: Heard, port: &str) -> String {
     use super::CoreError;
     let read = match e {
         CoreError::Timeout(r) | CoreError::Unconfirmed(r) => format!("the read of {}", r.name()),
-        CoreError::NoReadback(r) => format!("the readback of {}", readback_name(r)),
+        CoreError::NoReadback(r) => format!("the readback of {}", r.name()),
         _ => return words(e, heard == Heard::Nothing, port),
     };
     match heard {
@@ -312,25 +288,13 @@ pub fn words_heard(e: super::CoreError, heard: Heard, port: &str) -> String {
     }
 }
 
-/// A readback's name as the `chassis` command spells it.
-const fn readback_name(r: crate::v1::Readback) -> &'static str {
-    use crate::v1::Readback;
-    match r {
-        Readback::System => "system",
-        Readback::Geometry => "geometry",
-        Readback::BodyVelocity => "body-velocity",
-        Readback::MotorSpeeds => "motor-speeds",
-        Readback::Pid => "pid",
-    }
-}
-
 /// A driver error in the words of the `chassis` command (and of the Python package), for a
 /// person: `silent` says nothing at all came from the board on `port` (then, and only then, the
 /// words ask about power and wiring).
 #[must_use]
 pub fn words(e: super::CoreError, silent: bool, port: &str) -> String {
     use super::CoreError;
-    let readback = readback_name;
+    let readback = crate::v1::Readback::name;
     const WIRING: &str = "is it powered, TX wired to RX and RX to TX, at 115200 bps?";
     match e {
         CoreError::Timeout(r) | CoreError::Unconfirmed(r) if silent => format!(

@@ -211,6 +211,41 @@ pub trait Core: sealed::Sealed {
     fn wait_ms(&self, now_ms: u64) -> Option<u64>;
 }
 
+/// The accessors both shells ([`blocking::Driver`], [`asynch::Driver`]) have, in one text: the
+/// configuration, the UART and the core. Used inside each shell's `impl` block (fields `uart`
+/// and `core`, type parameters `U` and `K`).
+macro_rules! shell_accessors {
+    () => {
+        /// Changes the configuration, keeping everything the driver knows.
+        pub fn set_config(&mut self, config: $crate::driver::Config) {
+            self.core.set_config(config);
+        }
+
+        /// The UART (to inspect it; the driver keeps it).
+        pub const fn uart(&self) -> &U {
+            &self.uart
+        }
+
+        /// The UART, mutably (for a test double's controls; do not read from or write to it
+        /// behind the driver's back).
+        pub fn uart_mut(&mut self) -> &mut U {
+            &mut self.uart
+        }
+
+        /// The sans-IO core: latest telemetry, stream rates, parser counters, link state.
+        pub const fn core(&self) -> &K {
+            &self.core
+        }
+
+        /// The sans-IO core, mutably: [`DriverCore::abandon_turn`](crate::driver::DriverCore::abandon_turn),
+        /// [`DriverCore::abort`](crate::driver::DriverCore::abort).
+        pub fn core_mut(&mut self) -> &mut K {
+            &mut self.core
+        }
+    };
+}
+use shell_accessors;
+
 mod sealed {
     pub trait Sealed {}
     impl Sealed for super::DriverCore {}

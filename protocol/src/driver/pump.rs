@@ -461,6 +461,18 @@ macro_rules! pump_api {
         pub const fn last_heard_ms(&self) -> Option<u64> {
             self.pump.safety.last_heard_ms()
         }
+
+        /// What has come from the board, judged at `now_ms` (for
+        /// [`words_heard`]($crate::driver::host::words_heard)).
+        #[cfg(feature = "std")]
+        #[must_use]
+        pub fn heard(&self, now_ms: u64) -> $crate::driver::host::Heard {
+            $crate::driver::host::Heard::from_link(
+                self.last_heard_ms(),
+                self.link_alive(now_ms),
+                self.parser_stats().discarded,
+            )
+        }
     };
 }
 

@@ -83,6 +83,102 @@ pub use line::{Faults, OUT_CAPACITY};
 pub use serve::serve;
 pub use v2020::{Board, FACTORY, Motion, SimConfig};
 
+/// A simulated board's end of the wire: the line (pacing, faults), the parser of what the
+/// master sends, and the board's time.
+#[derive(Clone, Debug)]
+struct Port<P> {
+    line: line::Line,
+    uplink: P,
+    now_ms: u64,
+}
+
+impl<P> Port<P> {
+    /// A port at time 0, its line's faults drawn from `seed`.
+    fn new(seed: u64, uplink: P) -> Self {
+        Port {
+            line: line::Line::new(seed),
+            uplink,
+            now_ms: 0,
+        }
+    }
+}
+
+/// The wire side every simulated board has, in one text: faults, bytes in (each command the
+/// board's uplink parser finds goes to its `execute`), time (a millisecond at a time, through
+/// its `step_one_ms`), bytes out, and [`Simulated`]. Used in each board's module, on a `Board`
+/// with a field `port` ([`Port`]).
+macro_rules! wire_side {
+    () => {
+        impl Board {
+            /// Sets the faults to inject from now on.
+            pub fn set_faults(&mut self, faults: $crate::sim::Faults) {
+                self.port.line.faults = faults;
+            }
+
+            /// Bytes from the master, taken at the board's current time.
+            pub fn receive(&mut self, bytes: &[u8]) {
+                let mut rest = bytes;
+                loop {
+                    let (command, later) =
+                        $crate::stream::Parser::push_slice(&mut self.port.uplink, rest);
+                    rest = later;
+                    match command {
+                        Some(command) => self.execute(command),
+                        None => break,
+                    }
+                }
+            }
+
+            /// Moves the board's time forward to `now_ms` (ms since power-up): what the
+            /// chassis does, replies and telemetry fall due. Time never goes back.
+            pub fn advance(&mut self, now_ms: u64) {
+                while self.port.now_ms < now_ms {
+                    self.port.now_ms = self.port.now_ms.saturating_add(1);
+                    self.step_one_ms();
+                }
+            }
+
+            /// Copies bytes for the master into `buf`, with the faults applied; returns how
+            /// many.
+            pub fn transmit(&mut self, buf: &mut [u8]) -> usize {
+                self.port.line.transmit(self.port.now_ms, buf)
+            }
+
+            /// Whether a byte for the master has crossed the wire by now (what a UART's "data
+            /// ready" says).
+            #[must_use]
+            pub fn byte_arrived(&self) -> bool {
+                self.port.line.byte_arrived(self.port.now_ms)
+            }
+
+            /// The board's time in ms.
+            #[must_use]
+            pub const fn now_ms(&self) -> u64 {
+                self.port.now_ms
+            }
+        }
+
+        impl $crate::sim::Simulated for Board {
+            fn receive(&mut self, bytes: &[u8]) {
+                Board::receive(self, bytes);
+            }
+            fn advance(&mut self, now_ms: u64) {
+                Board::advance(self, now_ms);
+            }
+            fn transmit(&mut self, buf: &mut [u8]) -> usize {
+                Board::transmit(self, buf)
+            }
+            fn byte_arrived(&self) -> bool {
+                Board::byte_arrived(self)
+            }
+            fn now_ms(&self) -> u64 {
+                Board::now_ms(self)
+            }
+        }
+    };
+}
+use wire_side;
+
 /// What the adapters ([`SimUart`], with feature `driver`) and [`serve`] (feature `std`) need
 /// of a simulated board: both generations, [`Board`] (2020) and [`v1::Board`] (v1.0.0),
 /// implement it (each method is the board's own, of the same name).

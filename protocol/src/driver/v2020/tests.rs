@@ -15,6 +15,38 @@ fn reply(core: &mut DriverCore, register: Register, value: u32, now: u64) {
     while core.tick(now.saturating_add(5)).is_some() {}
 }
 
+/// An IMU frame with count `seq`, heard whole at `at`, then the line judged.
+fn imu(core: &mut DriverCore, seq: u8, at: u64) {
+    let frame = crate::Imu {
+        accel: [0; 3],
+        gyro: [0; 3],
+        seq,
+    }
+    .encode();
+    let mut rest = &frame[..];
+    while !rest.is_empty() {
+        rest = core.receive(rest, at).1;
+    }
+    let _ = core.tick(at);
+}
+
+/// The chassis told to move at `now`, and the frame sent.
+fn drive(core: &mut DriverCore, now: u64) {
+    core.velocity(Velocity::new(0, 100, 0), now).unwrap();
+    assert!(out(core, now).is_some());
+}
+
+/// The failsafe's stop came, at most `failsafe_ms` (and 2 ms of judging) after the board was
+/// last heard.
+fn assert_stopped_in_time(stopped: Option<u64>, heard: u64) {
+    let stopped = stopped.expect("the failsafe never stopped the chassis");
+    assert!(
+        stopped <= heard + u64::from(Config::DEFAULT.failsafe_ms) + 2,
+        "stopped {} ms after the board was last heard",
+        stopped - heard
+    );
+}
+
 /// A core that has read the pending angle (0): turns may be sent.
 fn idle_core() -> DriverCore {
     let mut core = DriverCore::new(Config::DEFAULT);
@@ -239,16 +271,14 @@ fn a_verified_read_that_never_agrees_is_unconfirmed() {
 #[test]
 fn the_failsafe_allows_the_settings_pause_but_not_a_dead_board() {
     let mut core = DriverCore::new(Config::DEFAULT);
-    core.velocity(Velocity::new(0, 100, 0), 0).unwrap();
-    assert!(out(&mut core, 0).is_some());
+    drive(&mut core, 0);
     let _ = core.tick(100);
     assert_eq!(out(&mut core, 100), None);
     let _ = core.tick(101);
     assert_eq!(out(&mut core, 101).as_deref(), Some(&STOP[..]));
     assert_eq!(core.failsafe_stops(), 1);
     // Moving again; a write makes the board pause: 600 ms allowed.
-    core.velocity(Velocity::new(0, 100, 0), 1_000).unwrap();
-    assert!(out(&mut core, 1_000).is_some());
+    drive(&mut core, 1_000);
     core.write(Write::MaxSpeed(10), 1_000).unwrap();
     assert!(out(&mut core, 1_000).is_some());
     let _ = core.tick(1_599);
@@ -267,26 +297,11 @@ fn the_settings_pause_ends_when_telemetry_comes_back() {
     // Found by the emulator test of the bring-up: a read just before a motion gave a board
     // that went silent mid-motion 600 ms instead of 100.
     let mut core = DriverCore::new(Config::DEFAULT);
-    core.velocity(Velocity::new(0, 100, 0), 0).unwrap();
-    assert!(out(&mut core, 0).is_some());
+    drive(&mut core, 0);
     core.write(Write::MaxSpeed(10), 0).unwrap();
     assert!(out(&mut core, 0).is_some());
-    let imu = crate::Imu {
-        accel: [0; 3],
-        gyro: [0; 3],
-        seq: 1,
-    };
-    for (i, at) in (150..=180).step_by(10).enumerate() {
-        let frame = crate::Imu {
-            seq: imu.seq.wrapping_add(i as u8),
-            ..imu
-        }
-        .encode();
-        let mut rest = &frame[..];
-        while !rest.is_empty() {
-            rest = core.receive(rest, at).1;
-        }
-        let _ = core.tick(at);
+    for (seq, at) in (1..).zip((150..=180).step_by(10)) {
+        imu(&mut core, seq, at);
     }
     assert!(core.last_telemetry_ms().is_some(), "telemetry is back");
     // Silent from 180: stopped after 100 ms, not 600 after the write.
@@ -302,26 +317,12 @@ fn telemetry_on_its_way_before_a_reply_does_not_end_the_settings_pause() {
     // moving, two IMU frames the board had sent before taking the read parsed right after
     // it, then the reply, then the board's pause: the failsafe stopped the chassis.
     let mut core = DriverCore::new(Config::DEFAULT);
-    let imu = |core: &mut DriverCore, seq: u8, at: u64| {
-        let frame = crate::Imu {
-            accel: [0; 3],
-            gyro: [0; 3],
-            seq,
-        }
-        .encode();
-        let mut rest = &frame[..];
-        while !rest.is_empty() {
-            rest = core.receive(rest, at).1;
-        }
-        let _ = core.tick(at);
-    };
     // Telemetry streaming (the parser locked on it), then the read.
     for seq in 1..=5 {
         imu(&mut core, seq, 0);
     }
     assert!(core.last_telemetry_ms().is_some());
-    core.velocity(Velocity::new(0, 100, 0), 0).unwrap();
-    assert!(out(&mut core, 0).is_some());
+    drive(&mut core, 0);
     core.start(Request::Read(Register::MaxSpeed)).unwrap();
     assert!(out(&mut core, 0).is_some());
     imu(&mut core, 6, 1);
@@ -343,8 +344,7 @@ fn reads_a_silent_board_leaves_unanswered_never_hold_the_failsafe_off() {
     // Moving from the core's time now (the reply was taken in at 705, on a quiet line).
     let heard = core.now_ms();
     let mut now = heard;
-    core.velocity(Velocity::new(0, 100, 0), now).unwrap();
-    assert!(out(&mut core, now).is_some());
+    drive(&mut core, now);
     let mut stopped = None;
     while now < 2_000 && stopped.is_none() {
         if !core.busy() {
@@ -360,12 +360,7 @@ fn reads_a_silent_board_leaves_unanswered_never_hold_the_failsafe_off() {
             }
         }
     }
-    let stopped = stopped.expect("the failsafe never stopped the chassis");
-    assert!(
-        stopped <= heard + u64::from(Config::DEFAULT.failsafe_ms) + 2,
-        "stopped {} ms after the board was last heard",
-        stopped - heard
-    );
+    assert_stopped_in_time(stopped, heard);
     assert_eq!(core.failsafe_stops(), 1);
 }
 
@@ -376,8 +371,7 @@ fn a_read_unanswered_ends_the_pause_an_answered_read_allowed() {
     // last frame heard, not settings_pause_ms after the last read answered.
     let mut core = idle_core();
     let mut now = 700;
-    core.velocity(Velocity::new(0, 100, 0), now).unwrap();
-    assert!(out(&mut core, now).is_some());
+    drive(&mut core, now);
     core.start(Request::Read(Register::MaxSpeed)).unwrap();
     assert!(out(&mut core, now).is_some());
     reply(&mut core, Register::MaxSpeed, 1_000, now + 1);
@@ -394,12 +388,7 @@ fn a_read_unanswered_ends_the_pause_an_answered_read_allowed() {
             stopped = Some(now);
         }
     }
-    let stopped = stopped.expect("the failsafe never stopped the chassis");
-    assert!(
-        stopped <= heard + u64::from(Config::DEFAULT.failsafe_ms) + 2,
-        "stopped {} ms after the board was last heard",
-        stopped - heard
-    );
+    assert_stopped_in_time(stopped, heard);
 }
 
 #[test]

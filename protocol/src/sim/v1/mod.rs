@@ -1,7 +1,7 @@
 //! A model of the board running the **v1.0.0** firmware (`7B … BCC 7D`, `docs/protocol-v1.md`):
 //! what it was told in, a 32-byte telemetry frame out every [`SimConfig::telemetry_period_ms`],
 //! a reply to each readback request. Same line as the 2020 [`Board`](super::Board) (115 200
-//! bps pacing, [`Faults`]), same rules: `no_std`, no allocation, no panic on any input.
+//! bps pacing, [`Faults`](super::Faults)), same rules: `no_std`, no allocation, no panic on any input.
 //!
 //! ```
 //! use chassis_protocol::sim::v1::{Board, SimConfig};
@@ -57,8 +57,7 @@
 //!   (6 %; at 20 commands/s about 90 % of the frames are so placed: 5.4 % lost, users report
 //!   ~6 %). Never while no command arrives. The random numbers come from the seed (xorshift).
 
-use super::line::Line;
-use super::{Faults, Simulated};
+use super::Port;
 use crate::v1::{COMMAND_LEN, Command, PAYLOAD_LEN, Readback, Reply, Stats, UplinkParser};
 use heapless::{Deque, HistoryBuf};
 
@@ -114,9 +113,7 @@ impl Default for SimConfig {
 #[derive(Clone, Debug)]
 pub struct Board {
     config: SimConfig,
-    line: Line,
-    uplink: UplinkParser,
-    now_ms: u64,
+    port: Port<UplinkParser>,
     /// The settings it keeps.
     registers: Registers,
     /// What the chassis does.
@@ -147,9 +144,9 @@ impl defmt::Format for Board {
         defmt::write!(
             f,
             "v1::Board {{ now_ms: {=u64}, velocity: {}, queued: {=usize} }}",
-            self.now_ms,
+            self.port.now_ms,
             self.velocity(),
-            self.line.queued()
+            self.port.line.queued()
         );
     }
 }
@@ -160,9 +157,7 @@ impl Board {
     pub fn new(config: SimConfig) -> Self {
         Board {
             config,
-            line: Line::new(config.seed),
-            uplink: UplinkParser::new(),
-            now_ms: 0,
+            port: Port::new(config.seed, UplinkParser::new()),
             registers: Registers::new(),
             chassis: Chassis::new(),
             streams: Streams::new(config.telemetry_period_ms),
@@ -174,48 +169,6 @@ impl Board {
                 forced_stops: 0,
             },
         }
-    }
-
-    /// Sets the faults to inject from now on.
-    pub fn set_faults(&mut self, faults: Faults) {
-        self.line.faults = faults;
-    }
-
-    /// Bytes from the master, taken at the board's current time.
-    pub fn receive(&mut self, bytes: &[u8]) {
-        for byte in bytes {
-            let mut found = self.uplink.push(*byte);
-            while let Some(command) = found {
-                self.execute(command);
-                found = self.uplink.poll();
-            }
-        }
-    }
-
-    /// Moves the board's time forward to `now_ms` (ms since power-up): the chassis turns,
-    /// replies and telemetry fall due. Time never goes back.
-    pub fn advance(&mut self, now_ms: u64) {
-        while self.now_ms < now_ms {
-            self.now_ms = self.now_ms.saturating_add(1);
-            self.step_one_ms();
-        }
-    }
-
-    /// Copies bytes for the master into `buf`, with the faults applied; returns how many.
-    pub fn transmit(&mut self, buf: &mut [u8]) -> usize {
-        self.line.transmit(self.now_ms, buf)
-    }
-
-    /// Whether a byte for the master has crossed the wire by now.
-    #[must_use]
-    pub fn byte_arrived(&self) -> bool {
-        self.line.byte_arrived(self.now_ms)
-    }
-
-    /// The board's time in ms.
-    #[must_use]
-    pub const fn now_ms(&self) -> u64 {
-        self.now_ms
     }
 
     /// Commands taken so far (of every kind).
@@ -251,7 +204,7 @@ impl Board {
     /// refused`).
     #[must_use]
     pub fn bad_frames(&self) -> u32 {
-        let s = self.uplink.stats();
+        let s = self.port.uplink.stats();
         s.bad_checksum
             .saturating_add(s.bad_end)
             .saturating_add(s.refused)
@@ -260,18 +213,18 @@ impl Board {
     /// What the board's parser of the master's bytes has seen.
     #[must_use]
     pub fn uplink_stats(&self) -> Stats {
-        self.uplink.stats()
+        self.port.uplink.stats()
     }
 
     /// Frames dropped because the line's buffer was full (nobody read them).
     #[must_use]
     pub const fn overflowed_frames(&self) -> u32 {
-        self.line.dropped_frames
+        self.port.line.dropped_frames
     }
 
     fn execute(&mut self, command: Command) {
         self.log.total = self.log.total.wrapping_add(1);
-        self.streams.last_command_ms = Some(self.now_ms);
+        self.streams.last_command_ms = Some(self.port.now_ms);
         self.log.commands.write(command);
         if let Some(count) = CODES
             .iter()
@@ -314,6 +267,7 @@ impl Board {
                     payload: payload_of(&frame),
                 };
                 let due = self
+                    .port
                     .now_ms
                     .saturating_add(u64::from(self.config.reply_delay_ms));
                 // More than eight requests unanswered: the newest is lost.
@@ -323,15 +277,15 @@ impl Board {
     }
 
     fn step_one_ms(&mut self) {
-        let now = self.now_ms;
+        let now = self.port.now_ms;
         self.move_chassis(now);
         while let Some((due, reply)) = self.replies.front().copied() {
             if due > now {
                 break;
             }
             let _ = self.replies.pop_front();
-            if !self.line.faults.replies_stopped {
-                self.line.send(now, &reply.encode());
+            if !self.port.line.faults.replies_stopped {
+                self.port.line.send(now, &reply.encode());
             }
         }
         self.send_due_telemetry(now);
@@ -347,20 +301,4 @@ fn payload_of(frame: &[u8; COMMAND_LEN]) -> [u8; PAYLOAD_LEN] {
     payload
 }
 
-impl Simulated for Board {
-    fn receive(&mut self, bytes: &[u8]) {
-        Board::receive(self, bytes);
-    }
-    fn advance(&mut self, now_ms: u64) {
-        Board::advance(self, now_ms);
-    }
-    fn transmit(&mut self, buf: &mut [u8]) -> usize {
-        Board::transmit(self, buf)
-    }
-    fn byte_arrived(&self) -> bool {
-        Board::byte_arrived(self)
-    }
-    fn now_ms(&self) -> u64 {
-        Board::now_ms(self)
-    }
-}
+super::wire_side!();

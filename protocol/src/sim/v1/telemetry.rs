@@ -43,7 +43,7 @@ impl Board {
     /// [`SimConfig::settings_pause_ms`](super::SimConfig::settings_pause_ms) ago).
     #[must_use]
     pub const fn telemetry_paused(&self) -> bool {
-        self.now_ms < self.streams.quiet_until_ms
+        self.port.now_ms < self.streams.quiet_until_ms
     }
 
     /// Telemetry frames sent.
@@ -61,6 +61,7 @@ impl Board {
 
     pub(super) fn pause_telemetry(&mut self) {
         self.streams.quiet_until_ms = self
+            .port
             .now_ms
             .saturating_add(u64::from(self.config.settings_pause_ms));
     }
@@ -73,14 +74,14 @@ impl Board {
         }
         let period = u64::from(self.config.telemetry_period_ms.max(1));
         self.streams.next_telemetry_ms = self.streams.next_telemetry_ms.saturating_add(period);
-        if self.line.faults.telemetry_stopped || self.telemetry_paused() {
+        if self.port.line.faults.telemetry_stopped || self.telemetry_paused() {
             return;
         }
         let busy = self
             .streams
             .last_command_ms
             .is_some_and(|t| now.saturating_sub(t) <= period);
-        if busy && self.line.chance(self.config.busy_drop_per_million) {
+        if busy && self.port.line.chance(self.config.busy_drop_per_million) {
             self.streams.telemetry_dropped = self.streams.telemetry_dropped.wrapping_add(1);
             return;
         }
@@ -92,7 +93,7 @@ impl Board {
             quaternion: quaternion(self.chassis.yaw_urad),
             battery_mv: self.chassis.battery_mv,
         };
-        self.line.send(now, &frame.encode());
+        self.port.line.send(now, &frame.encode());
         self.streams.telemetry_sent = self.streams.telemetry_sent.wrapping_add(1);
     }
 }

@@ -3,6 +3,7 @@
 //! with `v1::DownlinkParser`.
 
 use super::*;
+use crate::sim::Faults;
 use crate::v1::{Downlink, DownlinkParser, Parser, Telemetry};
 
 /// The vendor's readback requests, as `docs/protocol-v1.md` quotes them (BCC 48, 4F, 2B).

@@ -2,8 +2,7 @@
 //! its chassis and its telemetry clock. See [the module above](super) for the behaviour and
 //! the decisions where the spec is silent.
 
-use super::line::Line;
-use super::{Faults, Simulated};
+use super::Port;
 use crate::command::Command;
 use crate::parse::UplinkParser;
 use crate::registers::Snapshot;
@@ -46,9 +45,7 @@ impl Default for SimConfig {
 #[derive(Clone, Debug)]
 pub struct Board {
     config: SimConfig,
-    line: Line,
-    uplink: UplinkParser,
-    now_ms: u64,
+    port: Port<UplinkParser>,
     /// Its registers.
     registers: Registers,
     /// What the chassis does.
@@ -65,10 +62,10 @@ impl defmt::Format for Board {
         defmt::write!(
             f,
             "Board {{ now_ms: {=u64}, motion: {}, pending_deci_degrees: {=i64}, queued: {=usize} }}",
-            self.now_ms,
+            self.port.now_ms,
             self.chassis.motion,
             self.chassis.pending_deci_degrees,
-            self.line.queued()
+            self.port.line.queued()
         );
     }
 }
@@ -79,48 +76,13 @@ impl Board {
     pub fn new(config: SimConfig) -> Self {
         Board {
             config,
-            line: Line::new(config.seed),
-            uplink: UplinkParser::new(),
-            now_ms: 0,
+            port: Port::new(config.seed, UplinkParser::new()),
             registers: Registers::new(),
             chassis: Chassis::new(),
             streams: Streams::new(),
             replies: Deque::new(),
             commands: 0,
         }
-    }
-
-    /// Sets the faults to inject from now on.
-    pub fn set_faults(&mut self, faults: Faults) {
-        self.line.faults = faults;
-    }
-
-    /// Bytes from the master, taken at the board's current time.
-    pub fn receive(&mut self, bytes: &[u8]) {
-        let mut rest = bytes;
-        loop {
-            let (command, later) = self.uplink.push_slice(rest);
-            rest = later;
-            match command {
-                Some(command) => self.execute(command),
-                None => break,
-            }
-        }
-    }
-
-    /// Moves the board's time forward to `now_ms` (milliseconds since power-up): the chassis
-    /// moves, calibration runs, replies and telemetry fall due. Time never goes back.
-    pub fn advance(&mut self, now_ms: u64) {
-        while self.now_ms < now_ms {
-            self.now_ms = self.now_ms.saturating_add(1);
-            self.step_one_ms();
-        }
-    }
-
-    /// The board's time in ms.
-    #[must_use]
-    pub const fn now_ms(&self) -> u64 {
-        self.now_ms
     }
 
     /// The live registers.
@@ -162,7 +124,7 @@ impl Board {
     /// Whether telemetry is paused (settings being made).
     #[must_use]
     pub const fn telemetry_paused(&self) -> bool {
-        self.now_ms < self.streams.quiet_until_ms
+        self.port.now_ms < self.streams.quiet_until_ms
     }
 
     /// Commands executed so far.
@@ -174,7 +136,7 @@ impl Board {
     /// Downlink frames dropped because the output buffer was full.
     #[must_use]
     pub const fn dropped_frames(&self) -> u32 {
-        self.line.dropped_frames
+        self.port.line.dropped_frames
     }
 
     fn execute(&mut self, command: Command) {
@@ -209,7 +171,7 @@ impl Board {
     }
 
     fn step_one_ms(&mut self) {
-        let now = self.now_ms;
+        let now = self.port.now_ms;
         if self
             .registers
             .calibrating_until_ms
@@ -224,7 +186,7 @@ impl Board {
                 break;
             }
             let _ = self.replies.pop_front();
-            if !self.line.faults.replies_stopped {
+            if !self.port.line.faults.replies_stopped {
                 self.send(&reply.encode());
             }
         }
@@ -237,41 +199,13 @@ fn clamp_i32(v: i64) -> i32 {
 }
 
 impl Board {
-    /// Copies bytes for the master into `buf`, with the faults applied; returns how many.
-    pub fn transmit(&mut self, buf: &mut [u8]) -> usize {
-        self.line.transmit(self.now_ms, buf)
-    }
-
-    /// Whether a byte for the master has crossed the wire by now (what a UART's "data ready"
-    /// says).
-    #[must_use]
-    pub fn byte_arrived(&self) -> bool {
-        self.line.byte_arrived(self.now_ms)
-    }
-
     fn send(&mut self, bytes: &[u8]) {
-        self.line.send(self.now_ms, bytes);
+        self.port.line.send(self.port.now_ms, bytes);
     }
 
     fn next_random(&mut self) -> u64 {
-        self.line.next_random()
+        self.port.line.next_random()
     }
 }
 
-impl Simulated for Board {
-    fn receive(&mut self, bytes: &[u8]) {
-        Board::receive(self, bytes);
-    }
-    fn advance(&mut self, now_ms: u64) {
-        Board::advance(self, now_ms);
-    }
-    fn transmit(&mut self, buf: &mut [u8]) -> usize {
-        Board::transmit(self, buf)
-    }
-    fn byte_arrived(&self) -> bool {
-        Board::byte_arrived(self)
-    }
-    fn now_ms(&self) -> u64 {
-        Board::now_ms(self)
-    }
-}
+super::wire_side!();

@@ -101,7 +101,7 @@ impl Board {
                 .chassis
                 .pending_deci_degrees
                 .clamp(-TURN_DECI_DEGREES_PER_10_MS, TURN_DECI_DEGREES_PER_10_MS);
-            if self.now_ms.checked_rem(10) == Some(0) {
+            if self.port.now_ms.checked_rem(10) == Some(0) {
                 self.chassis.pending_deci_degrees =
                     self.chassis.pending_deci_degrees.saturating_sub(rate);
             }
@@ -111,7 +111,7 @@ impl Board {
         }
         let moving = speeds.iter().any(|s| *s != 0) || self.chassis.turn_carry != 0;
         let drain_every = if moving { 10_000 } else { 60_000 };
-        if self.now_ms.checked_rem(drain_every) == Some(0) {
+        if self.port.now_ms.checked_rem(drain_every) == Some(0) {
             self.chassis.centivolts = self.chassis.centivolts.saturating_sub(1);
         }
     }

@@ -46,6 +46,7 @@ const CALIBRATION_MS: u64 = 30_000;
 impl Board {
     pub(super) fn setting(&mut self, setting: Setting) {
         self.streams.quiet_until_ms = self
+            .port
             .now_ms
             .saturating_add(u64::from(self.config.resume_after_ms));
         match setting {
@@ -68,6 +69,7 @@ impl Board {
                     other => self.registers.live.value(other).unwrap_or(0),
                 };
                 let due = self
+                    .port
                     .now_ms
                     .saturating_add(u64::from(self.config.reply_delay_ms));
                 let _ = self.replies.push_back((due, Reply::new(register, value)));
@@ -107,6 +109,6 @@ impl Board {
     }
 
     pub(super) fn start_calibration(&mut self) {
-        self.registers.calibrating_until_ms = Some(self.now_ms.saturating_add(CALIBRATION_MS));
+        self.registers.calibrating_until_ms = Some(self.port.now_ms.saturating_add(CALIBRATION_MS));
     }
 }

@@ -34,7 +34,7 @@ impl Board {
     /// Sends every telemetry frame due at `now` (unless telemetry is stopped or paused; the
     /// clock goes on either way, so the rates hold when it resumes).
     pub(super) fn send_due_telemetry(&mut self, now: u64) {
-        let sending = !self.line.faults.telemetry_stopped && !self.telemetry_paused();
+        let sending = !self.port.line.faults.telemetry_stopped && !self.telemetry_paused();
         for stream in 0..3 {
             let (Some(due), Some(period)) = (
                 self.streams.next_due_ms.get(stream).copied(),

@@ -25,7 +25,7 @@
 //! Reserved direction bits, and reverse bits on an axis whose magnitude is 0 (a "negative
 //! zero"), are kept by `decode` and written back by `encode`, so every frame round-trips.
 
-use super::{HEADER, mode};
+use super::{HEADER, mode, mode_of};
 use crate::DriveType;
 use crate::error::Error;
 use crate::wire;
@@ -80,13 +80,7 @@ fn encode_body(x: i32, y: i32, z: i32, flags: u8) -> [u8; Velocity::LEN] {
 /// Decodes a mode-`0x01` frame into signed X / Y / Z, the raw direction byte and the bits to
 /// keep (reserved bits and reverse bits of zero magnitudes).
 fn decode_body(bytes: &[u8]) -> Result<([i32; 3], u8, u8), Error> {
-    if bytes.len() != Velocity::LEN {
-        return Err(Error::Length);
-    }
-    if bytes.get(field::HEADER..field::MODE) != Some(&HEADER[..]) {
-        return Err(Error::Header);
-    }
-    if wire::u8_at(bytes, field::MODE) != mode::VELOCITY {
+    if mode_of(bytes, Velocity::LEN)? != mode::VELOCITY {
         return Err(Error::Mode);
     }
     let direction = wire::u8_at(bytes, field::VELOCITY_DIR);
@@ -444,13 +438,7 @@ impl Motors {
 
     /// Decodes exactly one mode-`0x02` or mode-`0x03` frame.
     pub fn decode(bytes: &[u8]) -> Result<Self, Error> {
-        if bytes.len() != Self::LEN {
-            return Err(Error::Length);
-        }
-        if bytes.get(field::HEADER..field::MODE) != Some(&HEADER[..]) {
-            return Err(Error::Header);
-        }
-        let control = match wire::u8_at(bytes, field::MODE) {
+        let control = match mode_of(bytes, Self::LEN)? {
             mode::MOTORS_CLOSED_LOOP => MotorLoop::Closed,
             mode::MOTORS_OPEN_LOOP => MotorLoop::Open,
             _ => return Err(Error::Mode),

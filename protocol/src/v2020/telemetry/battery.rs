@@ -4,8 +4,7 @@
 //! |---|---|---|---|---|---|
 //! | | FF | FC | voltage, u16 in 0.01 V | charge, u16 in % | count |
 
-use super::check_frame;
-use crate::error::Error;
+use super::telemetry_frame;
 use crate::wire;
 
 /// Byte offsets of the battery frame.
@@ -40,27 +39,13 @@ pub struct Battery {
     pub seq: u8,
 }
 
+telemetry_frame!(Battery, [0xFF, 0xFC], 7, "battery");
+
 impl Battery {
-    /// The frame's first two bytes.
-    pub const HEADER: [u8; 2] = [0xFF, 0xFC];
-    /// Length of the frame on the wire.
-    pub const LEN: usize = 7;
-
-    /// The 7 bytes of this frame.
-    #[must_use]
-    pub fn encode(&self) -> [u8; Self::LEN] {
-        let mut buf = [0u8; Self::LEN];
-        wire::put(&mut buf, field::HEADER, &Self::HEADER);
-        wire::put_u16(&mut buf, field::CENTIVOLTS, self.centivolts);
-        wire::put_u16(&mut buf, field::PERCENT, self.percent);
-        wire::put_u8(&mut buf, field::SEQ, self.seq);
-        buf
-    }
-
-    /// Decodes exactly one battery frame.
-    pub fn decode(bytes: &[u8]) -> Result<Self, Error> {
-        check_frame(bytes, &Self::HEADER, Self::LEN)?;
-        bytes.first_chunk().map(Self::read).ok_or(Error::Length)
+    /// Writes the frame's own fields (between the header and the count).
+    fn write(&self, buf: &mut [u8; Self::LEN]) {
+        wire::put_u16(buf, field::CENTIVOLTS, self.centivolts);
+        wire::put_u16(buf, field::PERCENT, self.percent);
     }
 
     /// The fields of a frame whose header is already checked (the parser's hot path).
@@ -83,6 +68,7 @@ impl Battery {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::Error;
 
     /// From the 2E-3 table and its note: 1100 = 11 V.
     static GOLDEN: [u8; 7] = [0xFF, 0xFC, 0x04, 0x4C, 0x00, 0x64, 0xFF];

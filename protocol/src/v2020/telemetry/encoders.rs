@@ -8,8 +8,7 @@
 //! period or a running total. They decode as `i16`; compute motion with wrapping differences
 //! ([`Encoders::delta_since`]) and both readings work.
 
-use super::check_frame;
-use crate::error::Error;
+use super::telemetry_frame;
 use crate::wire;
 
 /// Byte offsets of the encoder frame.
@@ -38,28 +37,14 @@ pub struct Encoders {
     pub seq: u8,
 }
 
+telemetry_frame!(Encoders, [0xFF, 0xFB], 11, "encoder");
+
 impl Encoders {
-    /// The frame's first two bytes.
-    pub const HEADER: [u8; 2] = [0xFF, 0xFB];
-    /// Length of the frame on the wire.
-    pub const LEN: usize = 11;
-
-    /// The 11 bytes of this frame.
-    #[must_use]
-    pub fn encode(&self) -> [u8; Self::LEN] {
-        let mut buf = [0u8; Self::LEN];
-        wire::put(&mut buf, field::HEADER, &Self::HEADER);
+    /// Writes the frame's own fields (between the header and the count).
+    fn write(&self, buf: &mut [u8; Self::LEN]) {
         for (&value, at) in self.ticks.iter().zip(field::TICKS) {
-            wire::put_i16(&mut buf, at, value);
+            wire::put_i16(buf, at, value);
         }
-        wire::put_u8(&mut buf, field::SEQ, self.seq);
-        buf
-    }
-
-    /// Decodes exactly one encoder frame.
-    pub fn decode(bytes: &[u8]) -> Result<Self, Error> {
-        check_frame(bytes, &Self::HEADER, Self::LEN)?;
-        bytes.first_chunk().map(Self::read).ok_or(Error::Length)
     }
 
     /// The fields of a frame whose header is already checked (the parser's hot path).
@@ -89,6 +74,7 @@ impl Encoders {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::Error;
 
     /// From the 2E-2 table: encoders 0x0010, -4 (FF FC: a battery header inside the payload),
     /// 0x2301 (a `#` inside the payload), -32767 (80 01); count 0x00.

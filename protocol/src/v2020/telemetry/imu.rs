@@ -6,8 +6,7 @@
 //!
 //! Six big-endian `i16` in the sensor's raw units (not stated by the vendor).
 
-use super::check_frame;
-use crate::error::Error;
+use super::telemetry_frame;
 use crate::wire;
 
 /// Byte offsets of the IMU frame.
@@ -42,31 +41,17 @@ pub struct Imu {
     pub seq: u8,
 }
 
-impl Imu {
-    /// The frame's first two bytes.
-    pub const HEADER: [u8; 2] = [0xFF, 0xFA];
-    /// Length of the frame on the wire.
-    pub const LEN: usize = 15;
+telemetry_frame!(Imu, [0xFF, 0xFA], 15, "IMU");
 
-    /// The 15 bytes of this frame.
-    #[must_use]
-    pub fn encode(&self) -> [u8; Self::LEN] {
-        let mut buf = [0u8; Self::LEN];
-        wire::put(&mut buf, field::HEADER, &Self::HEADER);
+impl Imu {
+    /// Writes the frame's own fields (between the header and the count).
+    fn write(&self, buf: &mut [u8; Self::LEN]) {
         for (&value, at) in self.accel.iter().zip(field::ACCEL) {
-            wire::put_i16(&mut buf, at, value);
+            wire::put_i16(buf, at, value);
         }
         for (&value, at) in self.gyro.iter().zip(field::GYRO) {
-            wire::put_i16(&mut buf, at, value);
+            wire::put_i16(buf, at, value);
         }
-        wire::put_u8(&mut buf, field::SEQ, self.seq);
-        buf
-    }
-
-    /// Decodes exactly one IMU frame.
-    pub fn decode(bytes: &[u8]) -> Result<Self, Error> {
-        check_frame(bytes, &Self::HEADER, Self::LEN)?;
-        bytes.first_chunk().map(Self::read).ok_or(Error::Length)
     }
 
     /// The fields of a frame whose header is already checked (the parser's hot path).
@@ -87,6 +72,7 @@ impl Imu {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::Error;
 
     /// From the 2E-1 table: accel X = 0x0102, Y = -1 (FF FF), Z = 0x4000; gyro X = -6
     /// (FF FA, a false header inside the payload), Y = 0x7FFF, Z = -32768 (80 00); count 0xFE.

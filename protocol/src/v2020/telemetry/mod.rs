@@ -40,6 +40,41 @@ fn check_frame(bytes: &[u8], header: &[u8; 2], len: usize) -> Result<(), Error> 
     Ok(())
 }
 
+/// What the three telemetry frames have alike, written once: the header and length, `encode`
+/// (the header, the frame's own fields by its `write`, the count) and `decode` (length and
+/// header checked, then its `read`). Used in each frame's module, whose `field` offsets it
+/// names.
+macro_rules! telemetry_frame {
+    ($frame:ident, $header:expr, $len:literal, $what:literal) => {
+        impl $frame {
+            /// The frame's first two bytes.
+            pub const HEADER: [u8; 2] = $header;
+            /// Length of the frame on the wire.
+            pub const LEN: usize = $len;
+
+            #[doc = concat!("The ", stringify!($len), " bytes of this frame.")]
+            #[must_use]
+            pub fn encode(&self) -> [u8; Self::LEN] {
+                let mut buf = [0u8; Self::LEN];
+                $crate::wire::put(&mut buf, field::HEADER, &Self::HEADER);
+                self.write(&mut buf);
+                $crate::wire::put_u8(&mut buf, field::SEQ, self.seq);
+                buf
+            }
+
+            #[doc = concat!("Decodes exactly one ", $what, " frame.")]
+            pub fn decode(bytes: &[u8]) -> Result<Self, $crate::error::Error> {
+                super::check_frame(bytes, &Self::HEADER, Self::LEN)?;
+                bytes
+                    .first_chunk()
+                    .map(Self::read)
+                    .ok_or($crate::error::Error::Length)
+            }
+        }
+    };
+}
+use telemetry_frame;
+
 /// One of the three telemetry streams, each with its own rolling count.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
