@@ -62,20 +62,9 @@ class FrameError(ChassisError): ...
 
 # ----- names and dicts -----
 
-# 2020 register names (`Chassis.read` / `write`, `Read`, `Write`).
+# 2020 registers whose value is an int (`Chassis.read`; its overloads name the other three).
 _IntRegister = Literal[
     "max-speed", "kp", "ki", "gyro-gain", "gyro-calibration", "motor-voltage"
-]
-_Register = Literal[
-    "max-speed",
-    "kp",
-    "ki",
-    "gyro-gain",
-    "system-mode",
-    "gyro-calibration",
-    "motor-voltage",
-    "battery-range",
-    "pending-angle",
 ]
 
 # v1.0.0 readbacks and settings fields (`ChassisV1.read` / `write`).
