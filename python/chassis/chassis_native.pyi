@@ -62,20 +62,9 @@ class FrameError(ChassisError): ...
 
 # ----- names and dicts -----
 
-# 2020 register names (`Chassis.read` / `write`, `Read`, `Write`).
+# 2020 registers whose value is an int (`Chassis.read`; its overloads name the other three).
 _IntRegister = Literal[
     "max-speed", "kp", "ki", "gyro-gain", "gyro-calibration", "motor-voltage"
-]
-_Register = Literal[
-    "max-speed",
-    "kp",
-    "ki",
-    "gyro-gain",
-    "system-mode",
-    "gyro-calibration",
-    "motor-voltage",
-    "battery-range",
-    "pending-angle",
 ]
 
 # v1.0.0 readbacks and settings fields (`ChassisV1.read` / `write`).
@@ -127,11 +116,24 @@ def open(
     read_tries: int | None = None,
 ) -> Chassis | ChassisV1: ...
 
+# What a chassis and a simulated board's pseudo-terminal have alike: `close`, and a `with` block
+# that closes it on the way out; in the stubs only.
+class _Closable:
+    def close(self) -> None: ...
+    def __enter__(self) -> Self: ...
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        value: BaseException | None,
+        traceback: object,
+        /,
+    ) -> Literal[False]: ...
+
 _Yield = TypeVar("_Yield")
 
 # What every chassis has (`Chassis`, `ChassisV1`), `_Yield` being the frames it gives; the classes
 # share it in the stubs only (at run time each has its own methods).
-class _Chassis(Generic[_Yield]):
+class _Chassis(_Closable, Generic[_Yield]):
     @property
     def port(self) -> str: ...
     def stop(self) -> None: ...
@@ -149,15 +151,6 @@ class _Chassis(Generic[_Yield]):
     def streams(self) -> dict[str, _StreamInfo]: ...
     @property
     def counters(self) -> dict[str, int]: ...
-    def close(self) -> None: ...
-    def __enter__(self) -> Self: ...
-    def __exit__(
-        self,
-        kind: type[BaseException] | None,
-        value: BaseException | None,
-        traceback: object,
-        /,
-    ) -> Literal[False]: ...
 
 @final
 class Chassis(_Chassis[Imu | Encoders | Battery]):
@@ -404,43 +397,37 @@ class ReadbackReply(_Frame[ReadbackReply]):
 
 # ----- parsers -----
 
+_Parsed = TypeVar("_Parsed")
+
+# What every parser has (each generation, each direction), `_Parsed` being what `feed` gives: made
+# with no arguments, `feed` and `stats`; in the stubs only.
+class _Parser(Generic[_Parsed]):
+    def __new__(cls) -> Self: ...
+    def feed(self, data: bytes | bytearray) -> list[_Parsed]: ...
+    @property
+    def stats(self) -> dict[str, int]: ...
+
 @final
-class DownlinkParser:
-    def __new__(cls) -> DownlinkParser: ...
-    def feed(self, data: bytes | bytearray) -> list[Imu | Encoders | Battery | Reply]: ...
+class DownlinkParser(_Parser[Imu | Encoders | Battery | Reply]):
     def quiet(self, ms: int) -> list[Imu | Encoders | Battery | Reply]: ...
     def expect_reply(self, register: str | None) -> None: ...
-    @property
-    def stats(self) -> dict[str, int]: ...
 
+# Its `feed` gives a settings frame of no known form as a dict:
+# {"frame": "setting-raw", "code": int, "value": int, "tail": int}.
 @final
-class UplinkParser:
-    def __new__(cls) -> UplinkParser: ...
-    # A settings frame of no known form comes as a dict:
-    # {"frame": "setting-raw", "code": int, "value": int, "tail": int}.
-    def feed(
-        self, data: bytes | bytearray
-    ) -> list[Velocity | Turn | Motors | Read | Write | Action | dict[str, str | int]]: ...
+class UplinkParser(
+    _Parser[Velocity | Turn | Motors | Read | Write | Action | dict[str, str | int]]
+):
     def quiet(self, ms: int) -> None: ...
-    @property
-    def stats(self) -> dict[str, int]: ...
 
 @final
-class V1DownlinkParser:
-    def __new__(cls) -> V1DownlinkParser: ...
-    def feed(self, data: bytes | bytearray) -> list[Telemetry | ReadbackReply]: ...
+class V1DownlinkParser(_Parser[Telemetry | ReadbackReply]):
     def quiet(self) -> None: ...
-    @property
-    def stats(self) -> dict[str, int]: ...
 
+# Its `feed` gives commands other than a body velocity as dicts of their fields (JSON-like values).
 @final
-class V1UplinkParser:
-    def __new__(cls) -> V1UplinkParser: ...
-    # Commands other than a body velocity come as dicts of their fields (JSON-like values).
-    def feed(self, data: bytes | bytearray) -> list[BodyVelocity | dict[str, Any]]: ...
+class V1UplinkParser(_Parser[BodyVelocity | dict[str, Any]]):
     def quiet(self) -> None: ...
-    @property
-    def stats(self) -> dict[str, int]: ...
 
 # ----- captures -----
 
@@ -477,7 +464,7 @@ class Board:
     def now_ms(self) -> int: ...
 
 @final
-class Pty:
+class Pty(_Closable):
     @property
     def path(self) -> str: ...
     @property
@@ -488,14 +475,5 @@ class Pty:
     def silent(self) -> bool: ...
     @silent.setter
     def silent(self, silent: bool) -> None: ...
-    def close(self) -> None: ...
-    def __enter__(self) -> Pty: ...
-    def __exit__(
-        self,
-        kind: type[BaseException] | None,
-        value: BaseException | None,
-        traceback: object,
-        /,
-    ) -> Literal[False]: ...
 
 def pty(firmware: str = "2020", seed: int = 1) -> Pty: ...

@@ -1,5 +1,6 @@
-"""Shared fixtures: a simulated board of either firmware on a pseudo-terminal (the real OS
-serial stack), and the frames the board must receive, written by hand from the spec's tables."""
+"""Shared fixtures: each firmware generation in turn, a simulated board of either firmware on a
+pseudo-terminal (the real OS serial stack), and the frames the board must receive, written by
+hand from the spec's tables."""
 
 from __future__ import annotations
 
@@ -40,6 +41,13 @@ DRIVE = """
             bot.set_velocity(0, speed, 0)
             time.sleep(0.02)
 """
+
+
+@pytest.fixture(params=["2020", "v1.0.0"])
+def firmware(request: pytest.FixtureRequest) -> str:
+    """Each firmware generation in turn: a test that takes `firmware` runs once for each."""
+    generation: str = request.param
+    return generation
 
 
 @pytest.fixture

@@ -99,7 +99,6 @@ def end_by_signal(firmware: str, sig: signal.Signals, moment: float) -> Ending:
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP], ids=["SIGINT", "SIGTERM", "SIGHUP"])
-@pytest.mark.parametrize("firmware", ["2020", "v1.0.0"])
 def test_a_driving_program_ended_by_a_signal_at_any_moment_leaves_the_chassis_stopped(
     firmware: str, sig: signal.Signals
 ) -> None:

@@ -53,7 +53,6 @@ FORKED = """
 
 @pytest.mark.parametrize("what", ["exits", "uses"])
 @pytest.mark.parametrize("how", ["os.fork", "multiprocessing"])
-@pytest.mark.parametrize("firmware", ["2020", "v1.0.0"])
 def test_a_chassis_inherited_by_a_child_process_is_inert_there(
     target: chassis.sim.Pty, firmware: str, how: str, what: str
 ) -> None:

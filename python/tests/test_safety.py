@@ -179,7 +179,6 @@ READER_THREAD = """
 """
 
 
-@pytest.mark.parametrize("firmware", ["2020", "v1.0.0"])
 def test_a_program_ending_with_a_thread_still_reading_stops_the_chassis_and_exits_cleanly(
     board: chassis.sim.Pty, v1_board: chassis.sim.Pty, firmware: str
 ) -> None:

@@ -51,7 +51,6 @@ def expect_line(p: subprocess.Popen[bytes], line: bytes) -> None:
 
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP], ids=["SIGTERM", "SIGHUP"])
-@pytest.mark.parametrize("firmware", ["2020", "v1.0.0"])
 def test_sigterm_and_sighup_stop_the_chassis_then_end_the_process_with_their_status(
     target: chassis.sim.Pty, firmware: str, sig: signal.Signals
 ) -> None:

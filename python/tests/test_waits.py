@@ -48,7 +48,6 @@ def blocked_then(bot: chassis.Chassis | chassis.ChassisV1, call: Callable[[], ob
 
 @pytest.mark.parametrize("how", ["stop", "close"])
 @pytest.mark.parametrize("call", ["read", "settings"])
-@pytest.mark.parametrize("firmware", ["2020", "v1.0.0"])
 def test_a_stop_of_another_thread_goes_out_at_once_while_a_call_waits(
     target: chassis.sim.Pty, firmware: str, call: str, how: str
 ) -> None:
@@ -78,7 +77,6 @@ def test_a_stop_of_another_thread_goes_out_at_once_while_a_call_waits(
     target.silent = False
 
 
-@pytest.mark.parametrize("firmware", ["2020", "v1.0.0"])
 def test_the_failsafe_keeps_its_time_while_another_thread_reads(target: chassis.sim.Pty, firmware: str) -> None:
     # A thread reads in a loop (answered, then unanswered once the board goes silent); the
     # failsafe still stops the chassis its own time after the board was last heard (2020:
