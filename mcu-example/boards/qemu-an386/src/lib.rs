@@ -1,10 +1,12 @@
 //! Board support for QEMU's mps2-an386 (Cortex-M4 at 25 MHz): UART0 (the link to the chassis)
 //! and a SysTick millisecond clock. The binaries: `bringup` (the bring-up, `src/main.rs`), the
 //! size probes (`src/bin/size_*.rs`, measured by `cargo xtask size`) and the instruction-count
-//! run of the board → master parsers, 2020 and v1.0.0 (`src/bin/icount.rs`).
+//! runs of the board → master parsers, 2020 and v1.0.0 (`src/bin/icount.rs`,
+//! `src/bin/icount_v1.rs`: the work of both in [`icount`]).
 
 #![no_std]
 
+pub mod icount;
 pub mod probe;
 pub mod stack;
 pub mod time;
