@@ -73,12 +73,18 @@ impl Telemetry {
         if code != TELEMETRY_CODE {
             return Err(FrameError::UnknownCode(code));
         }
+        // Each field by name, not `array::map`: the optimiser does not always unroll that one,
+        // and this is the parser's frame-completing byte (`cargo xtask icount`: 1 566 against
+        // 894 instructions on the Cortex-M4).
         let at = |i: usize| wire::i16_at(bytes, i);
+        let ([v0, v1, v2], [a0, a1, a2], [g0, g1, g2]) =
+            (field::VELOCITY, field::ACCEL, field::GYRO);
+        let [qw, qx, qy, qz] = field::QUATERNION;
         Ok(Telemetry {
-            velocity: field::VELOCITY.map(at),
-            accel: field::ACCEL.map(at),
-            gyro: field::GYRO.map(at),
-            quaternion: field::QUATERNION.map(at),
+            velocity: [at(v0), at(v1), at(v2)],
+            accel: [at(a0), at(a1), at(a2)],
+            gyro: [at(g0), at(g1), at(g2)],
+            quaternion: [at(qw), at(qx), at(qy), at(qz)],
             battery_mv: at(field::BATTERY),
         })
     }
