@@ -1,8 +1,10 @@
-//! What the CLI's edge tests share: a simulated board on a real pseudo-terminal that records
-//! every byte it is sent and can go silent, a terminal for the commands that need one, and the
-//! spec's stop frame.
+//! What the CLI's tests share: a simulated board on a real pseudo-terminal that records every
+//! byte it is sent and can go silent, a terminal for the commands that need one, and the spec's
+//! stop frame; the golden captures and their decoding ([`decoding`]).
 
 #![allow(dead_code)]
+
+pub mod decoding;
 
 use chassis_protocol::sim::{Board, Faults, Motion, SimConfig, Simulated, serve};
 use chassis_protocol::{Command, UplinkParser};
