@@ -1,7 +1,8 @@
 //! `chassis monitor`: a live view of the board's telemetry; with `--drive`, keys drive it. This
-//! module holds what both firmware generations share (the terminal, the keys, the failsafe's
-//! hold, the link and its stale marks: [`Monitor`] over a [`Chassis`]); each generation's
-//! screen and board are in its own module ([`crate::v2020::monitor`], [`crate::v1::monitor`]).
+//! module holds what both firmware generations share (the terminal, the driver, the keys, the
+//! failsafe's hold, the link and its stale marks: [`Monitor`] over a [`Chassis`]; the screen's
+//! title and keys lines and its drive panel); each generation's screen and board are in its own
+//! module ([`crate::v2020::monitor`], [`crate::v1::monitor`]).
 //!
 //! The screen is drawn from a view (a plain value taken from the driver each frame), so a test
 //! renders it with ratatui's test backend. Keys: arrows or WASD
@@ -13,57 +14,63 @@
 //! the figures of a board gone quiet are marked stale.
 
 mod terminal;
+#[cfg(test)]
+pub mod testing;
+#[cfg(test)]
+mod tests;
 
 use crate::ending;
+use crate::stopping::{self, HostDriver, Spoken};
+use chassis_protocol::driver::host::SerialError;
+use chassis_protocol::driver::{Core, Error};
 use ratatui::Frame;
 use ratatui::crossterm::event::{Event, KeyCode, KeyEventKind, KeyModifiers};
-use ratatui::layout::Rect;
+use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
 use std::time::{Duration, Instant};
 
-/// What the monitor needs of a board, whichever its firmware: the driver's pump, its motion
-/// frames, its failsafe count, and the generation's screen. Velocities are `[x, y, z]`: x
-/// sideways (right positive), y forward, z the rotation, in the generation's own units.
+/// What differs between the generations under the monitor: their motion frames, their turn,
+/// what their screen keeps and shows. The host driver is the monitor's ([`Monitor`]: its pump,
+/// its failsafe count, its stop, written once); each method that talks to the board is lent
+/// it. Velocities are `[x, y, z]`: x sideways (right positive), y forward, z the rotation, in
+/// the generation's own units.
 pub trait Chassis {
+    /// The generation's driver core.
+    type Core: Spoken;
+
     /// What the generation's screen shows, taken each frame.
     type View;
 
-    /// The port's path.
-    fn port(&self) -> &str;
+    /// Keeps what the screen needs of an event the driver took in (the 2020 board: the gyro
+    /// Z history). Does nothing unless implemented.
+    fn took(&mut self, event: &<Self::Core as Core>::Event) {
+        let _ = event;
+    }
 
-    /// Takes in what the port holds, without blocking: `Ok(true)` when a frame of any kind
-    /// came, `Ok(false)` when nothing waits. The driver judges its failsafe here.
-    fn poll(&mut self) -> Result<bool, String>;
-
-    /// Times the driver's failsafe has stopped the chassis.
-    fn failsafe_stops(&self) -> u32;
-
-    /// Sends `velocity` (re-sent every 50 ms while it is not zero).
-    fn drive(&mut self, velocity: [i32; 3]) -> Result<(), String>;
-
-    /// Sends the generation's stop (on the 2020 board a turn is cancelled too).
-    fn stop(&mut self) -> Result<(), String>;
-
-    /// The stop on the way out, never cut short: `Ok` with what it did when the chassis is
-    /// known to have stopped, `Err` with what is known otherwise ([`stopping::stop`]).
-    fn stop_on_exit(&mut self) -> Result<String, String>;
+    /// Sends `velocity` through `driver` (re-sent every 50 ms while it is not zero).
+    fn drive(
+        &self,
+        driver: &mut HostDriver<Self::Core>,
+        velocity: [i32; 3],
+    ) -> Result<(), Error<SerialError>>;
 
     /// The rate the rotate keys (`z`, `x`) turn at, in the generation's z unit; or why there
     /// are none.
     fn rotate_rate(&self) -> Result<i32, &'static str>;
 
-    /// `t`, a turn by 90° sent once, with the link `alive` or not: `Ok(message)` when it was
-    /// sent (the chassis moves: the failsafe's hold ends), `Err(message)` when nothing was.
-    fn turn(&mut self, alive: bool) -> Result<String, String>;
+    /// `t`, a turn by 90° sent once through `driver`, with the link `alive` or not:
+    /// `Ok(message)` when it was sent (the chassis moves: the failsafe's hold ends),
+    /// `Err(message)` when nothing was.
+    fn turn(&mut self, driver: &mut HostDriver<Self::Core>, alive: bool) -> Result<String, String>;
 
     /// What follows the poll each tick (the 2020 board reads a turn's pending angle): a
     /// message to show, if any.
-    fn follow_up(&mut self) -> Option<String>;
+    fn follow_up(&mut self, driver: &mut HostDriver<Self::Core>) -> Option<String>;
 
-    /// The screen's contents now, `status` being the monitor's part.
-    fn view(&self, status: Status) -> Self::View;
+    /// The screen's contents now, from the driver's `core`, `status` being the monitor's part.
+    fn view(&self, core: &Self::Core, status: Status) -> Self::View;
 
     /// Draws the whole screen.
     fn render(frame: &mut Frame<'_>, view: &Self::View);
@@ -90,16 +97,37 @@ pub struct Status {
     pub message: String,
 }
 
-/// The top line: the name, the port, LINK UP / NO LINK, STALE, then `tail`.
-pub fn title_bar(
+/// What every generation's screen has around its own panels: the title bar on top (the name,
+/// the port, LINK UP / NO LINK, STALE, then `tail`) and the keys line at the bottom
+/// (`driving_keys` while driving). The area between them, for the generation's panels.
+pub fn screen_frame(
     frame: &mut Frame<'_>,
-    area: Rect,
-    port: &str,
-    alive: bool,
-    stale_ms: Option<u64>,
+    status: &Status,
     tail: String,
-) {
-    let link = if alive {
+    driving_keys: &str,
+) -> Rect {
+    let [title, body, keys] = Layout::vertical([
+        Constraint::Length(1),
+        Constraint::Min(10),
+        Constraint::Length(3),
+    ])
+    .areas(frame.area());
+    title_bar(frame, title, status, tail);
+    frame.render_widget(
+        Paragraph::new(if status.driving {
+            driving_keys
+        } else {
+            "q quit"
+        })
+        .block(Block::new().borders(Borders::TOP)),
+        keys,
+    );
+    body
+}
+
+/// The top line: the name, the port, LINK UP / NO LINK, STALE, then `tail`.
+fn title_bar(frame: &mut Frame<'_>, area: Rect, status: &Status, tail: String) {
+    let link = if status.link_alive {
         Span::styled(" LINK UP ", Style::new().fg(Color::Black).bg(Color::Green))
     } else {
         Span::styled(" NO LINK ", Style::new().fg(Color::White).bg(Color::Red))
@@ -110,9 +138,9 @@ pub fn title_bar(
                 " chassis monitor ",
                 Style::new().add_modifier(Modifier::BOLD),
             ),
-            Span::raw(format!("{port}  ")),
+            Span::raw(format!("{}  ", status.port)),
             link,
-            Span::raw(match stale_ms {
+            Span::raw(match status.stale_ms {
                 Some(ms) => format!("  STALE {:.1} s", ms as f64 / 1000.0),
                 None => String::new(),
             }),
@@ -132,34 +160,18 @@ pub fn rate_text(rate_millihertz: u32, stale_ms: Option<u64>) -> String {
 }
 
 /// The drive panel: the hold, what is being sent (`driving_line`), or read only; the message.
-pub fn drive_panel(
-    frame: &mut Frame<'_>,
-    area: Rect,
-    driving: bool,
-    held: bool,
-    driving_line: String,
-    message: &str,
-) {
-    let first = if driving && held {
+pub fn drive_panel(frame: &mut Frame<'_>, area: Rect, status: &Status, driving_line: String) {
+    let first = if status.driving && status.held {
         "stopped by the failsafe: press a key to drive again (once LINK UP)".to_string()
-    } else if driving {
+    } else if status.driving {
         driving_line
     } else {
         "read only (start with --drive to drive)".to_string()
     };
     frame.render_widget(
-        Paragraph::new(vec![Line::from(first), Line::from(message.to_string())])
+        Paragraph::new(vec![Line::from(first), Line::from(status.message.clone())])
             .wrap(Wrap { trim: true })
             .block(Block::bordered().title(" drive ")),
-        area,
-    );
-}
-
-/// The keys line at the bottom.
-pub fn keys_bar(frame: &mut Frame<'_>, area: Rect, driving: bool, driving_keys: &str) {
-    frame.render_widget(
-        Paragraph::new(if driving { driving_keys } else { "q quit" })
-            .block(Block::new().borders(Borders::TOP)),
         area,
     );
 }
@@ -219,10 +231,11 @@ impl Key {
     }
 }
 
-/// The monitor's logic, apart from the terminal and from the generation: what the keys did,
-/// the failsafe's hold, the link. [`run_monitor`] feeds it the terminal's keys; a test feeds
-/// it keys of its own.
-pub struct Monitor<C> {
+/// The monitor's logic, apart from the terminal and from the generation: the board's driver,
+/// what the keys did, the failsafe's hold, the link. [`run_monitor`] feeds it the terminal's
+/// keys; a test feeds it keys of its own.
+pub struct Monitor<C: Chassis> {
+    driver: HostDriver<C::Core>,
     chassis: C,
     drive: bool,
     speed: i32,
@@ -237,9 +250,11 @@ pub struct Monitor<C> {
 }
 
 impl<C: Chassis> Monitor<C> {
-    /// A monitor over `chassis`; `drive`: keys drive at `speed`.
-    pub fn new(chassis: C, drive: bool, speed: i32) -> Self {
+    /// A monitor of the board behind `driver`, its generation's part `chassis`; `drive`: keys
+    /// drive at `speed`.
+    pub fn new(driver: HostDriver<C::Core>, chassis: C, drive: bool, speed: i32) -> Self {
         Monitor {
+            driver,
             chassis,
             drive,
             speed,
@@ -249,6 +264,25 @@ impl<C: Chassis> Monitor<C> {
             last_frame: None,
             message: String::new(),
             next_send: Instant::now(),
+        }
+    }
+
+    /// A driver error as one line, in the CLI's words.
+    fn explain(&self, e: Error<SerialError>) -> String {
+        stopping::explain(&self.driver, e)
+    }
+
+    /// Takes in what the port holds, without blocking: `Ok(true)` when a frame of any kind
+    /// came ([`Chassis::took`]), `Ok(false)` when nothing waits. The driver judges its
+    /// failsafe here.
+    fn poll(&mut self) -> Result<bool, String> {
+        match self.driver.poll() {
+            Ok(Some(event)) => {
+                self.chassis.took(&event);
+                Ok(true)
+            }
+            Ok(None) => Ok(false),
+            Err(e) => Err(self.explain(e)),
         }
     }
 
@@ -264,13 +298,13 @@ impl<C: Chassis> Monitor<C> {
     pub fn tick(&mut self, ms: u64) {
         let until = Instant::now() + Duration::from_millis(ms);
         while Instant::now() < until && ending::ended().is_none() {
-            match self.chassis.poll() {
+            match self.poll() {
                 Ok(true) => self.last_frame = Some(Instant::now()),
                 Ok(false) => std::thread::sleep(Duration::from_millis(1)),
                 Err(e) => self.message = e,
             }
         }
-        let stops = self.chassis.failsafe_stops();
+        let stops = self.driver.core().failsafe_stops();
         if stops != self.failsafe_seen {
             self.failsafe_seen = stops;
             if self.drive {
@@ -283,12 +317,12 @@ impl<C: Chassis> Monitor<C> {
         if self.drive && Instant::now() >= self.next_send {
             self.next_send = Instant::now() + Duration::from_millis(50);
             if self.velocity != [0; 3] && !self.held {
-                if let Err(e) = self.chassis.drive(self.velocity) {
-                    self.message = e;
+                if let Err(e) = self.chassis.drive(&mut self.driver, self.velocity) {
+                    self.message = self.explain(e);
                 }
             }
         }
-        if let Some(message) = self.chassis.follow_up() {
+        if let Some(message) = self.chassis.follow_up(&mut self.driver) {
             self.message = message;
         }
     }
@@ -313,9 +347,9 @@ impl<C: Chassis> Monitor<C> {
             },
             Key::Stop => {
                 self.velocity = [0; 3];
-                self.message = match self.chassis.stop() {
+                self.message = match self.driver.stop() {
                     Ok(()) => "stopped".into(),
-                    Err(e) => e,
+                    Err(e) => self.explain(e),
                 };
                 return true;
             }
@@ -333,7 +367,8 @@ impl<C: Chassis> Monitor<C> {
                 return true;
             }
             Key::Turn => {
-                match self.chassis.turn(self.link_alive()) {
+                let alive = self.link_alive();
+                match self.chassis.turn(&mut self.driver, alive) {
                     Ok(message) => {
                         self.held = false;
                         self.message = message;
@@ -357,40 +392,51 @@ impl<C: Chassis> Monitor<C> {
     /// What the screen shows now.
     pub fn view(&self) -> C::View {
         let alive = self.link_alive();
-        self.chassis.view(Status {
-            port: self.chassis.port().to_string(),
-            link_alive: alive,
-            stale_ms: if alive {
-                None
-            } else {
-                self.last_frame
-                    .map(|t| u64::try_from(t.elapsed().as_millis()).unwrap_or(u64::MAX))
+        self.chassis.view(
+            self.driver.core(),
+            Status {
+                port: self.driver.uart().name().to_string(),
+                link_alive: alive,
+                stale_ms: if alive {
+                    None
+                } else {
+                    self.last_frame
+                        .map(|t| u64::try_from(t.elapsed().as_millis()).unwrap_or(u64::MAX))
+                },
+                driving: self.drive,
+                held: self.held,
+                speed: self.speed,
+                velocity: self.velocity,
+                message: self.message.clone(),
             },
-            driving: self.drive,
-            held: self.held,
-            speed: self.speed,
-            velocity: self.velocity,
-            message: self.message.clone(),
-        })
+        )
     }
 
-    /// The stop on the way out (cancelling a turn), if this monitor drives the chassis (`None`:
-    /// it only watches): [`Chassis::stop_on_exit`].
+    /// The stop on the way out (cancelling a turn), never cut short, if this monitor drives
+    /// the chassis (`None`: it only watches): `Ok` with what it did when the chassis is known
+    /// to have stopped, `Err` with what is known otherwise ([`stopping::stop`]).
     pub fn stop_on_exit(&mut self) -> Option<Result<String, String>> {
         if !self.drive {
             return None;
         }
         self.velocity = [0; 3];
-        Some(self.chassis.stop_on_exit())
+        let stopped = stopping::stop(&mut self.driver);
+        let words = stopped.words::<C::Core>();
+        Some(if stopped.confirmed() {
+            Ok(words)
+        } else {
+            Err(words)
+        })
     }
 }
 
 /// `chassis monitor [--drive]` over the board `open` opens (once the terminal is known to be
-/// one): draws until a quit key or an ending ([`crate::ending`]: a signal, the terminal gone),
+/// one), `chassis` its generation's part: draws until a quit key or an ending ([`crate::ending`]: a signal, the terminal gone),
 /// then stops the chassis before giving the terminal back. The terminal is read and drawn on
 /// threads of their own ([`terminal`]): nothing it does keeps this loop from the driver.
 pub fn run_monitor<C: Chassis>(
-    open: impl FnOnce() -> Result<C, String>,
+    open: impl FnOnce() -> Result<HostDriver<C::Core>, String>,
+    chassis: C,
     drive: bool,
     speed: i32,
 ) -> Result<(), String>
@@ -403,7 +449,7 @@ where
             "monitor draws on a terminal and reads its keys: run it in one (stdin and stdout a terminal, not a pipe or a file); `chassis record` captures without one".into(),
         );
     }
-    let mut monitor = Monitor::new(open()?, drive, speed);
+    let mut monitor = Monitor::new(open()?, chassis, drive, speed);
     crate::ending::before_motion()?;
     let screen = terminal::Screen::start(
         ratatui::try_init().map_err(|e| format!("terminal: {e}"))?,
@@ -458,22 +504,4 @@ where
         }
     }
     Ok(())
-}
-
-/// The text a screen `render` draws from `view` on a 100 × 24 terminal (ratatui's test
-/// backend), a line per row: what the screens' tests read.
-#[cfg(test)]
-pub fn screen_text<V>(render: fn(&mut Frame<'_>, &V), view: &V) -> String {
-    let mut terminal =
-        ratatui::Terminal::new(ratatui::backend::TestBackend::new(100, 24)).expect("a terminal");
-    let _ = terminal.draw(|f| render(f, view));
-    let buffer = terminal.backend().buffer().clone();
-    let mut text = String::new();
-    for y in 0..buffer.area.height {
-        for x in 0..buffer.area.width {
-            text.push_str(buffer[(x, y)].symbol());
-        }
-        text.push('\n');
-    }
-    text
 }

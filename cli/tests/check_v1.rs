@@ -8,52 +8,23 @@
 
 mod harness;
 
-use chassis_protocol::sim::v1::{Board, SimConfig};
+use chassis_protocol::sim::v1::Board;
 use chassis_protocol::v1::BodyVelocity;
+use harness::v1::{FORCED_STOP, FORWARD, frames, v1_board};
 use harness::{TestBoard, signal, wait};
 use std::process::Output;
 use std::time::{Duration, Instant};
 
-/// `0x25` forced stop: ctl 0, all zeros; BCC 7B ^ 25 = 5E.
-const FORCED_STOP: [u8; 14] = [0x7B, 0x25, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x5E, 0x7D];
-/// `0x25`: vy 0.3 m/s = 300 mm/s (01 2C), ctl 2, type 4; BCC 7B^25^02^04^01^2C = 75: the
-/// check's forward drive.
-const FORWARD: [u8; 14] = [
-    0x7B, 0x25, 0x02, 0x04, 0, 0, 0x01, 0x2C, 0, 0, 0, 0, 0x75, 0x7D,
-];
 /// The readback requests' codes (system, geometry, body velocity, motor speeds, PID).
 const READBACKS: [u8; 5] = [0x33, 0x34, 0x35, 0x36, 0x50];
 /// The settings frames' codes (system, geometry, PID): the check never sends one.
 const SETTINGS: [u8; 3] = [0x23, 0x24, 0x40];
-
-fn v1_board() -> TestBoard<Board> {
-    TestBoard::serving(Board::new(SimConfig::default()))
-}
 
 fn text(out: &Output) -> (String, String) {
     (
         String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
-}
-
-/// The heard bytes as 14-byte frames (each must be whole, its BCC and end right).
-fn frames(heard: &[u8]) -> Vec<[u8; 14]> {
-    assert_eq!(heard.len() % 14, 0, "only whole frames: {heard:02X?}");
-    heard
-        .chunks(14)
-        .map(|c| {
-            let frame = <[u8; 14]>::try_from(c).unwrap();
-            assert_eq!(frame[0], 0x7B, "{frame:02X?}");
-            assert_eq!(frame[13], 0x7D, "{frame:02X?}");
-            assert_eq!(
-                frame[..12].iter().fold(0, |x, b| x ^ b),
-                frame[12],
-                "BCC of {frame:02X?}"
-            );
-            frame
-        })
-        .collect()
 }
 
 /// Waits until the board was sent the check's forward drive.

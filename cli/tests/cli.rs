@@ -2,44 +2,16 @@
 //! spec's tables), every bad input of the CLI issue, and the device commands against the
 //! simulated board through a real pseudo-terminal.
 
+mod harness;
+
+use harness::chassis;
+use harness::decoding::{
+    CAPTURES_2020, assert_decodes_to, assert_golden_decodes, chassis_with_input, golden, json_lines,
+};
 use serde_json::Value;
 use std::io::{BufRead, BufReader};
-use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::Duration;
-
-fn chassis(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_chassis"))
-        .args(args)
-        .stdin(Stdio::null())
-        .output()
-        .expect("the binary runs")
-}
-
-fn golden(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/golden")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
-}
-
-fn json_lines(text: &str) -> Vec<Value> {
-    text.lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| serde_json::from_str(l).expect("a JSON object per line"))
-        .collect()
-}
-
-/// `chassis args` succeeds and writes the JSON lines of the golden file `expected`.
-fn assert_decodes_to(args: &[&str], expected: &str) -> Output {
-    let out = chassis(args);
-    assert!(out.status.success(), "{out:?}");
-    let got = json_lines(&String::from_utf8_lossy(&out.stdout));
-    let want = json_lines(&std::fs::read_to_string(golden(expected)).unwrap());
-    assert_eq!(got, want, "{expected}");
-    out
-}
 
 /// One line on stderr, a non-zero exit, nothing on stdout.
 fn assert_clear_error(out: &Output, needle: &str) {
@@ -55,32 +27,8 @@ fn assert_clear_error(out: &Output, needle: &str) {
 
 #[test]
 fn decode_golden_files() {
-    for (input, args, expected) in [
-        ("downlink.hex", &["--input", "hex"][..], "downlink.jsonl"),
-        (
-            "uplink.hex",
-            &["--input", "hex", "--uplink"][..],
-            "uplink.jsonl",
-        ),
-        (
-            "downlink_logic2.csv",
-            &["--input", "saleae-csv"][..],
-            "downlink_logic2.jsonl",
-        ),
-        (
-            "uplink_logic1.csv",
-            &["--input", "saleae-csv", "--uplink"][..],
-            "uplink_logic1.jsonl",
-        ),
-    ] {
-        let path = golden(input);
-        let mut all = vec!["decode", path.as_str()];
-        all.extend_from_slice(args);
-        let out = chassis(&all);
-        assert!(out.status.success(), "{input}: {:?}", out);
-        let got = json_lines(&String::from_utf8_lossy(&out.stdout));
-        let want = json_lines(&std::fs::read_to_string(golden(expected)).unwrap());
-        assert_eq!(got, want, "{input}");
+    for (input, args, expected) in CAPTURES_2020 {
+        let out = assert_golden_decodes(input, args, expected);
         let summary = String::from_utf8_lossy(&out.stderr);
         assert!(summary.contains("0 bytes discarded"), "{summary}");
     }
@@ -203,16 +151,7 @@ fn decode_raw_bytes_from_standard_input() {
                 .map(move |i| u8::from_str_radix(&g[i..i + 2], 16).unwrap())
         })
         .collect();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_chassis"))
-        .args(["decode", "-", "--format", "text"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    use std::io::Write;
-    child.stdin.take().unwrap().write_all(&bytes).unwrap();
-    let out = child.wait_with_output().unwrap();
+    let out = chassis_with_input(&["decode", "-", "--format", "text"], &bytes);
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
     assert_eq!(text.lines().count(), 11, "{text}");

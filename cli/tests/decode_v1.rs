@@ -51,71 +51,41 @@
 //! vy 300 at 40 ms (7B, `25` 5E, `02` 5C, `04` 58, `01` 59, `2C` **75**); the board sends T2 at
 //! 55 ms.
 
-use serde_json::Value;
-use std::io::Write;
-use std::path::Path;
-use std::process::{Command, Output, Stdio};
+mod harness;
 
-fn chassis(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_chassis"))
-        .args(args)
-        .stdin(Stdio::null())
-        .output()
-        .expect("the binary runs")
-}
-
-/// `chassis args` with `input` on standard input.
-fn chassis_with_input(args: &[&str], input: &[u8]) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_chassis"))
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the binary runs");
-    child
-        .stdin
-        .take()
-        .expect("its standard input")
-        .write_all(input)
-        .expect("the input written");
-    child.wait_with_output().expect("the binary ends")
-}
-
-fn golden(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/golden")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
-}
-
-fn json_lines(text: &str) -> Vec<Value> {
-    text.lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| serde_json::from_str(l).expect("a JSON object per line"))
-        .collect()
-}
+use harness::chassis;
+use harness::decoding::{
+    self, CAPTURES_2020, assert_golden_decodes, chassis_with_input, golden, json_lines,
+};
+use std::process::Output;
 
 fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
-/// `chassis args` succeeds, writes the JSON lines of the golden file `expected`, and its one-line
-/// summary holds every one of `said`. The summary.
-fn assert_decodes_to(args: &[&str], expected: &str, said: &[&str]) -> String {
-    let out = chassis(args);
-    let summary = stderr(&out);
-    assert!(out.status.success(), "{args:?}: {summary}");
+/// The one-line summary of `out`, a decode that succeeded: it holds every one of `said`.
+fn summary_saying(out: &Output, said: &[&str]) -> String {
+    let summary = stderr(out);
     assert!(!summary.contains("panicked"), "{summary}");
     assert_eq!(summary.lines().count(), 1, "one line: {summary}");
-    let got = json_lines(&String::from_utf8_lossy(&out.stdout));
-    let want = json_lines(&std::fs::read_to_string(golden(expected)).unwrap());
-    assert_eq!(got, want, "{expected}");
     for words in said {
         assert!(summary.contains(words), "{words:?} in {summary:?}");
     }
     summary
+}
+
+/// `chassis args` succeeds, writes the JSON lines of the golden file `expected`, and its one-line
+/// summary holds every one of `said`. The summary.
+fn assert_decodes_to(args: &[&str], expected: &str, said: &[&str]) -> String {
+    summary_saying(&decoding::assert_decodes_to(args, expected), said)
+}
+
+/// `chassis args` succeeds with no frame on stdout, its summary saying `said`.
+fn assert_no_frame(args: &[&str], said: &str) {
+    let out = chassis(args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(out.stdout.is_empty());
+    assert!(stderr(&out).contains(said), "{}", stderr(&out));
 }
 
 /// The bytes of a hex golden file, read here (not by the binary).
@@ -129,10 +99,8 @@ fn hex_bytes(name: &str) -> Vec<u8> {
 
 #[test]
 fn a_v1_capture_is_detected_and_decoded_exactly() {
-    let path = golden("v1_downlink.hex");
-    assert_decodes_to(
-        &["decode", path.as_str(), "--input", "hex"],
-        "v1_downlink.jsonl",
+    summary_saying(
+        &assert_golden_decodes("v1_downlink.hex", &["--input", "hex"], "v1_downlink.jsonl"),
         &[
             "firmware v1.0.0 (detected)",
             "166 bytes: 8 frames (telemetry 3, reply 5)",
@@ -150,10 +118,12 @@ fn a_v1_capture_is_detected_and_decoded_exactly() {
 
 #[test]
 fn a_v1_uplink_capture_is_detected_and_decoded_exactly() {
-    let path = golden("v1_uplink.hex");
-    assert_decodes_to(
-        &["decode", path.as_str(), "--input", "hex", "--uplink"],
-        "v1_uplink.jsonl",
+    summary_saying(
+        &assert_golden_decodes(
+            "v1_uplink.hex",
+            &["--input", "hex", "--uplink"],
+            "v1_uplink.jsonl",
+        ),
         &[
             "firmware v1.0.0 (detected)",
             "126 bytes: 9 frames",
@@ -168,10 +138,8 @@ fn noise_and_a_bad_bcc_are_counted_and_never_output() {
     // `00 FF 7B 12 55` (5 bytes: 12 is no frame's code), T2 at 5, R34 with its BCC 45 for 44
     // at 37 (counted, its 14 bytes discarded), R33 at 51, `FF FF` at 65, T1 at 67, and the
     // first 4 bytes of a telemetry frame cut by the end: 5 + 14 + 2 + 4 = 25 bytes discarded.
-    let path = golden("v1_noisy.hex");
-    assert_decodes_to(
-        &["decode", path.as_str(), "--input", "hex"],
-        "v1_noisy.jsonl",
+    summary_saying(
+        &assert_golden_decodes("v1_noisy.hex", &["--input", "hex"], "v1_noisy.jsonl"),
         &[
             "firmware v1.0.0 (detected)",
             "103 bytes: 3 frames (telemetry 2, reply 1)",
@@ -184,16 +152,12 @@ fn noise_and_a_bad_bcc_are_counted_and_never_output() {
 #[test]
 fn both_sides_of_a_v1_capture_in_time_order() {
     let path = golden("v1_both_logic2.csv");
-    assert_decodes_to(
-        &[
-            "decode",
-            path.as_str(),
-            "--input",
-            "saleae-csv",
-            "--master-analyzer",
-            "master",
-        ],
-        "v1_both.jsonl",
+    summary_saying(
+        &assert_golden_decodes(
+            "v1_both_logic2.csv",
+            &["--input", "saleae-csv", "--master-analyzer", "master"],
+            "v1_both.jsonl",
+        ),
         &[
             "firmware v1.0.0 (detected)",
             "board: 78 bytes: 3 frames (telemetry 2, reply 1)",
@@ -306,35 +270,14 @@ fn reserved_bytes_of_a_reply_are_shown_when_not_00() {
 
 #[test]
 fn the_2020_golden_captures_are_still_2020() {
-    for (input, args, expected) in [
-        ("downlink.hex", &["--input", "hex"][..], "downlink.jsonl"),
-        (
-            "uplink.hex",
-            &["--input", "hex", "--uplink"][..],
-            "uplink.jsonl",
-        ),
-        (
-            "downlink_logic2.csv",
-            &["--input", "saleae-csv"][..],
-            "downlink_logic2.jsonl",
-        ),
-        (
-            "uplink_logic1.csv",
-            &["--input", "saleae-csv", "--uplink"][..],
-            "uplink_logic1.jsonl",
-        ),
-        (
-            "both_logic2.csv",
-            &["--input", "saleae-csv", "--master-analyzer", "master"][..],
-            "both.jsonl",
-        ),
-    ] {
-        let path = golden(input);
-        let mut all = vec!["decode", path.as_str()];
-        all.extend_from_slice(args);
-        assert_decodes_to(
-            &all,
-            expected,
+    let both: (&str, &[&str], &str) = (
+        "both_logic2.csv",
+        &["--input", "saleae-csv", "--master-analyzer", "master"],
+        "both.jsonl",
+    );
+    for (input, args, expected) in CAPTURES_2020.into_iter().chain([both]) {
+        summary_saying(
+            &assert_golden_decodes(input, args, expected),
             &["firmware 2020 (detected)", "0 bytes discarded"],
         );
     }
@@ -371,37 +314,29 @@ fn the_global_firmware_option_skips_detection() {
         &["firmware 2020 (given)", "0 bytes discarded"],
     );
     // Told the other generation: no frame, every byte discarded, said.
-    let out = chassis(&[
-        "decode",
-        v1.as_str(),
-        "--input",
-        "hex",
-        "--firmware",
-        "2020",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    assert!(out.stdout.is_empty());
-    assert!(
-        stderr(&out).contains("firmware 2020 (given); 166 bytes: imu 0, encoders 0, battery 0, reply 0; 166 bytes discarded"),
-        "{}",
-        stderr(&out)
+    assert_no_frame(
+        &[
+            "decode",
+            v1.as_str(),
+            "--input",
+            "hex",
+            "--firmware",
+            "2020",
+        ],
+        "firmware 2020 (given); 166 bytes: imu 0, encoders 0, battery 0, reply 0; 166 bytes discarded",
     );
     let up = golden("uplink.hex");
-    let out = chassis(&[
-        "decode",
-        up.as_str(),
-        "--input",
-        "hex",
-        "--uplink",
-        "--firmware",
-        "v1",
-    ]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    assert!(out.stdout.is_empty());
-    assert!(
-        stderr(&out).contains("firmware v1.0.0 (given); 94 bytes: 0 frames; 0 bad BCC"),
-        "{}",
-        stderr(&out)
+    assert_no_frame(
+        &[
+            "decode",
+            up.as_str(),
+            "--input",
+            "hex",
+            "--uplink",
+            "--firmware",
+            "v1",
+        ],
+        "firmware v1.0.0 (given); 94 bytes: 0 frames; 0 bad BCC",
     );
 }
 

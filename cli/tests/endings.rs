@@ -4,6 +4,7 @@
 
 mod harness;
 
+use harness::v1::v1_board;
 use harness::{TestBoard, assert_stopped};
 use std::time::{Duration, Instant};
 
@@ -144,12 +145,6 @@ fn a_command_that_talks_to_no_board_still_dies_of_a_signal() {
     }
     use std::os::unix::process::ExitStatusExt;
     assert_eq!(child.wait().unwrap().signal(), Some(2));
-}
-
-fn v1_board() -> TestBoard<chassis_protocol::sim::v1::Board> {
-    TestBoard::serving(chassis_protocol::sim::v1::Board::new(
-        chassis_protocol::sim::v1::SimConfig::default(),
-    ))
 }
 
 #[test]

@@ -6,33 +6,13 @@
 
 mod harness;
 
-use chassis_protocol::sim::v1::{Board, SimConfig};
+use harness::v1::{FORCED_STOP, FORWARD, frames, v1_board};
 use harness::{TestBoard, signal, wait};
 use serialport::{SerialPort as _, TTYPort};
 use std::time::{Duration, Instant};
 
-/// `0x25` forced stop: ctl 0, all zeros; BCC 7B ^ 25 = 5E.
-const FORCED_STOP: [u8; 14] = [0x7B, 0x25, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x5E, 0x7D];
-/// `0x25`: vy 0.3 m/s = 300 mm/s (01 2C), ctl 2, type 4; BCC 7B^25^02^04^01^2C = 75.
-const FORWARD: [u8; 14] = [
-    0x7B, 0x25, 0x02, 0x04, 0, 0, 0x01, 0x2C, 0, 0, 0, 0, 0x75, 0x7D,
-];
-
-fn v1_board() -> TestBoard<Board> {
-    TestBoard::serving(Board::new(SimConfig::default()))
-}
-
 fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
-}
-
-/// The heard bytes as 14-byte frames (each must be whole).
-fn frames(heard: &[u8]) -> Vec<[u8; 14]> {
-    assert_eq!(heard.len() % 14, 0, "only whole frames: {heard:02X?}");
-    heard
-        .chunks(14)
-        .map(|c| <[u8; 14]>::try_from(c).unwrap())
-        .collect()
 }
 
 #[test]

@@ -9,41 +9,71 @@
 //! frames would overwrite what the owner tuned). v1.0.0 has no drive-type register and no turn
 //! by an angle: its checks are eight, the turn a rotation at a rate.
 
-use crate::check::{Ending, Session, ending, not_run, stopped_words};
+use crate::check::{Session, Steps, driver_words, timing};
 use crate::port;
-use crate::stopping::core_words;
 use chassis_bringup::link::Common;
-use chassis_bringup::v1::{Failure, Link, Plan, Report, Why, bring_up};
-use chassis_bringup::{Check, LinkError, Note, Skip, Timing};
-use chassis_protocol::driver::Error;
+use chassis_bringup::v1::{Link, Plan, Report, Why, bring_up};
+use chassis_bringup::{Check, LinkError, Skip};
 use chassis_protocol::driver::host::Heard;
 use chassis_protocol::driver::v1::{DriverCore, Event};
 use chassis_protocol::v1::{BodyVelocity, Readback, Reply};
-use std::io::Write as _;
-use std::time::Instant;
 
 /// What the check does to a v1.0.0 chassis, said before it starts.
 const MOTION: &str = "the chassis will move: forward and sideways at 0.3 m/s for 0.4 s each, a rotation at 1 rad/s for 1.2 s (about 70°), then 1.5 s forward at 0.15 m/s. Give it about a metre of clear floor, or lift it so its wheels turn freely";
 
-/// The checks of a v1.0.0 board, in order: the 2020 ones but the drive type (no register holds
-/// one).
-fn checks() -> impl Iterator<Item = Check> {
-    Check::ALL.into_iter().filter(|c| *c != Check::DriveType)
-}
+/// What the v1.0.0 check says of itself: eight checks, the 2020 ones but the drive type (no
+/// register holds one); its turn is a rotation at a rate.
+impl Steps for DriverCore {
+    type Report = Report;
+    const PASS_NOTE: &str = " (firmware v1.0.0)";
 
-/// A check's name on v1.0.0 (its turn is a rotation at a rate).
-const fn name(check: Check) -> &'static str {
-    match check {
-        Check::Turn => "rotation",
-        other => other.name(),
+    fn checks() -> impl Iterator<Item = Check> {
+        Check::ALL.into_iter().filter(|c| *c != Check::DriveType)
+    }
+
+    fn name(check: Check) -> &'static str {
+        match check {
+            Check::Turn => "rotation",
+            other => other.name(),
+        }
+    }
+
+    fn telemetry(event: &Event) -> bool {
+        matches!(event, Event::Telemetry(_))
+    }
+
+    fn detail(session: &Checker, check: Check, seconds: f64) -> String {
+        match check {
+            Check::Link => format!("{} telemetry frames in {seconds:.1} s", session.frames),
+            Check::Battery => Common::core(session)
+                .telemetry()
+                .map_or_else(String::new, |t| {
+                    format!("{:.2} V", units(t.value.battery_mv.into()))
+                }),
+            _ => String::new(),
+        }
+    }
+
+    fn skipped(why: Skip) -> &'static str {
+        match why {
+            Skip::NoMotion => "--no-motion",
+            Skip::DriveTypeKept | Skip::NoSideways | Skip::NoEncoders => "not on v1.0.0",
+        }
+    }
+
+    fn found(check: Check, _said: &str, report: &Report) -> String {
+        passed_detail(check, report)
+    }
+
+    fn counted(report: &Report) -> String {
+        format!("frames refused by the parser: {}", report.bad_frames)
     }
 }
 
 /// The check's [`Link`]: the host driver, with a progress line per check and an ending (a
 /// signal, the terminal or input gone: [`crate::ending`]) turned into an error at the next
-/// call (the bring-up then sends the forced stop itself). A check done keeps whether it passed
-/// (`false`: skipped).
-type Checker = Session<DriverCore, bool>;
+/// call (the bring-up then sends the forced stop itself).
+type Checker = Session<DriverCore>;
 
 impl Link for Checker {
     fn set_velocity(&mut self, velocity: BodyVelocity) -> Result<(), LinkError> {
@@ -56,71 +86,6 @@ impl Link for Checker {
     }
 }
 
-impl Common for Checker {
-    type Core = DriverCore;
-    type Event = Event;
-    fn now_ms(&mut self) -> u64 {
-        self.inner.now_ms()
-    }
-    fn core(&self) -> &DriverCore {
-        Common::core(&self.inner)
-    }
-    fn poll(&mut self) -> Result<Option<Event>, LinkError> {
-        self.go_on()?;
-        let event = self.inner.poll()?;
-        if let Some(Event::Telemetry(_)) = event {
-            self.frames = self.frames.saturating_add(1);
-        }
-        Ok(event)
-    }
-    fn stop(&mut self) -> Result<(), LinkError> {
-        Session::stop(self, Common::stop)
-    }
-    fn note(&mut self, note: Note) {
-        let index = |c: Check| checks().position(|x| x == c).unwrap_or(0) + 1;
-        let mut out = std::io::stdout().lock();
-        match note {
-            Note::Start(check) => {
-                self.step = Instant::now();
-                self.frames = 0;
-                self.current = Some(check);
-                let _ = write!(out, "[{}/8] {:<13}", index(check), name(check));
-            }
-            Note::Passed(check) => {
-                let seconds = self.step.elapsed().as_secs_f64();
-                let detail = match check {
-                    Check::Link => format!("{} telemetry frames in {seconds:.1} s", self.frames),
-                    Check::Battery => Common::core(&self.inner)
-                        .telemetry()
-                        .map_or_else(String::new, |t| {
-                            format!("{:.2} V", units(t.value.battery_mv.into()))
-                        }),
-                    _ => String::new(),
-                };
-                let _ = writeln!(out, "ok    {seconds:>4.1} s  {detail}");
-                self.done.push((check, true));
-                self.current = None;
-            }
-            Note::Skipped(check, why) => {
-                let _ = writeln!(
-                    out,
-                    "[{}/8] {:<13}skipped ({})",
-                    index(check),
-                    name(check),
-                    match why {
-                        Skip::NoMotion => "--no-motion",
-                        Skip::DriveTypeKept | Skip::NoSideways | Skip::NoEncoders => {
-                            "not on v1.0.0"
-                        }
-                    }
-                );
-                self.done.push((check, false));
-            }
-        }
-        let _ = out.flush();
-    }
-}
-
 /// Milli-units as units with two decimals.
 fn units(milli: i32) -> f64 {
     f64::from(milli) / 1000.0
@@ -129,12 +94,7 @@ fn units(milli: i32) -> f64 {
 /// Why a check failed, in words.
 fn why(why: Why, heard: Heard, port: &str) -> String {
     match why {
-        Why::Driver(Error::Transport(embedded_io::ErrorKind::Interrupted)) => "interrupted".into(),
-        Why::Driver(Error::Core(e)) => core_words(e, heard, port),
-        Why::Driver(Error::Transport(kind)) => format!(
-            "the serial port failed ({kind:?}): was the adapter unplugged, or the board's power cut?"
-        ),
-        Why::Driver(e) => format!("the driver failed: {e:?}"),
+        Why::Driver(e) => driver_words(e, heard, port),
         Why::Rate(per_10s) if heard == Heard::Nothing => format!(
             "no telemetry ({:.1} Hz): is the board powered, TX wired to RX and RX to TX, at 115200 bps?",
             f64::from(per_10s) / 10.0
@@ -171,38 +131,6 @@ fn why(why: Why, heard: Heard, port: &str) -> String {
             "the board went quiet: the driver's failsafe sent the forced stop".into()
         }
     }
-}
-
-/// The verdict of a passed check, one line per check.
-fn verdict(report: &Report, done: &[(Check, bool)], motion: bool, seconds: f64) -> String {
-    let passed = done.iter().filter(|(_, p)| *p).count();
-    let skipped = done.len() - passed;
-    let mut lines = vec![format!(
-        "PASS: {passed} checks passed{} in {seconds:.1} s (firmware v1.0.0)",
-        if skipped > 0 {
-            format!(", {skipped} skipped")
-        } else {
-            String::new()
-        }
-    )];
-    for (check, passed) in done {
-        let detail = if *passed {
-            passed_detail(*check, report)
-        } else {
-            "skipped".to_string()
-        };
-        lines.push(format!("  {:<13} {detail}", name(*check)));
-    }
-    lines.push(format!(
-        "  frames refused by the parser: {}; {}",
-        report.bad_frames,
-        if motion {
-            "the chassis is stopped (forced stop)"
-        } else {
-            "nothing moved, nothing was written"
-        }
-    ));
-    lines.join("\n")
 }
 
 /// What a passed check found, for its line of the verdict.
@@ -266,33 +194,11 @@ pub fn check(path: &str, no_motion: bool, yes: bool) -> Result<(), (String, u8)>
         }
     );
     let plan = Plan {
-        timing: Timing {
-            motion: !no_motion,
-            ..Timing::DEFAULT
-        },
+        timing: timing(no_motion),
         ..Plan::DEFAULT
     };
     let result = bring_up(&mut link, &plan);
-    let seconds = link.start.elapsed().as_secs_f64();
-    let failure = match result {
-        Ok(report) => {
-            say!("\n{}", verdict(&report, &link.done, !no_motion, seconds));
-            return Ok(());
-        }
-        Err(failure) => failure,
-    };
-    let now = link.now_ms();
-    let heard = Common::core(&link).heard(now);
-    let stopped = stopped_words(link.last_stop, no_motion, true, |e| {
-        why(Why::Driver(e), heard, path)
-    });
-    let Failure { check, why: reason } = failure;
-    Err(ending(Ending {
-        check: name(check),
-        under_way: link.current.is_some(),
-        not_run: not_run(checks(), check, &link.done, no_motion, name),
-        stopped,
-        why: why(reason, heard, path),
-        code: u8::try_from(check.exit_code()).unwrap_or(1),
-    }))
+    link.conclude(result, no_motion, path, |reason, heard| {
+        why(reason, heard, path)
+    })
 }

@@ -10,10 +10,11 @@
 //! * the keys drive at `--speed` mm/s, `z` / `x` rotate at [`ROTATE_MRAD_S`], space sends the
 //!   forced stop; there is no turn by an angle (`t` only says so).
 
-use crate::monitor::{Chassis, Status, drive_panel, keys_bar, rate_text, title_bar};
+use crate::monitor::{Chassis, Status, drive_panel, rate_text, screen_frame};
 use crate::port::BoardV1;
 use chassis_protocol::driver::Error;
 use chassis_protocol::driver::host::SerialError;
+use chassis_protocol::driver::v1::DriverCore;
 use chassis_protocol::v1::{BodyVelocity, Telemetry};
 use ratatui::Frame;
 use ratatui::layout::{Constraint, Layout, Rect};
@@ -72,19 +73,11 @@ pub struct View {
 /// Draws the v1.0.0 board's whole screen.
 pub fn render(frame: &mut Frame<'_>, view: &View) {
     let status = &view.status;
-    let [title, body, keys] = Layout::vertical([
-        Constraint::Length(1),
-        Constraint::Min(10),
-        Constraint::Length(3),
-    ])
-    .areas(frame.area());
-    title_bar(
+    let body = screen_frame(
         frame,
-        title,
-        &status.port,
-        status.link_alive,
-        status.stale_ms,
+        status,
         "  firmware v1.0.0".into(),
+        "arrows/WASD drive  z/x rotate 0.5 rad/s  space forced stop  +/- speed  q or Ctrl-C quit",
     );
     let [top, drive_area] =
         Layout::vertical([Constraint::Length(10), Constraint::Min(4)]).areas(body);
@@ -99,8 +92,7 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
     drive_panel(
         frame,
         drive_area,
-        status.driving,
-        status.held,
+        status,
         format!(
             "driving at {} m/s: vx {} vy {} m/s, wz {} rad/s",
             units(status.speed),
@@ -108,13 +100,6 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
             units(vy),
             units(wz)
         ),
-        &status.message,
-    );
-    keys_bar(
-        frame,
-        keys,
-        status.driving,
-        "arrows/WASD drive  z/x rotate 0.5 rad/s  space forced stop  +/- speed  q or Ctrl-C quit",
     );
 }
 
@@ -213,81 +198,36 @@ fn render_link(frame: &mut Frame<'_>, area: Rect, view: &View) {
     );
 }
 
-/// A driver error as one line, in the CLI's words.
-fn explain(driver: &BoardV1, e: Error<SerialError>) -> String {
-    crate::stopping::explain(driver, e)
-}
-
 /// A velocity component as the frame's 16 bits (the keys never go past ±2000).
 fn i16_of(v: i32) -> i16 {
     i16::try_from(v).unwrap_or(if v < 0 { i16::MIN } else { i16::MAX })
 }
 
-/// The v1.0.0 board under the monitor.
-pub struct BoardV1Chassis {
-    driver: BoardV1,
-}
-
-impl BoardV1Chassis {
-    /// The board behind `driver`.
-    pub fn new(driver: BoardV1) -> Self {
-        BoardV1Chassis { driver }
-    }
-}
+/// The v1.0.0 board under the monitor: it keeps nothing beside the driver.
+pub struct BoardV1Chassis;
 
 impl Chassis for BoardV1Chassis {
+    type Core = DriverCore;
     type View = View;
 
-    fn port(&self) -> &str {
-        self.driver.uart().name()
-    }
-
-    fn poll(&mut self) -> Result<bool, String> {
-        match self.driver.poll() {
-            Ok(event) => Ok(event.is_some()),
-            Err(e) => Err(explain(&self.driver, e)),
-        }
-    }
-
-    fn failsafe_stops(&self) -> u32 {
-        self.driver.core().failsafe_stops()
-    }
-
-    fn drive(&mut self, velocity: [i32; 3]) -> Result<(), String> {
+    fn drive(&self, driver: &mut BoardV1, velocity: [i32; 3]) -> Result<(), Error<SerialError>> {
         let [vx, vy, wz] = velocity.map(i16_of);
-        self.driver
-            .set_velocity(BodyVelocity::new(vx, vy, wz))
-            .map_err(|e| explain(&self.driver, e))
-    }
-
-    fn stop(&mut self) -> Result<(), String> {
-        self.driver.stop().map_err(|e| explain(&self.driver, e))
-    }
-
-    fn stop_on_exit(&mut self) -> Result<String, String> {
-        let stopped = crate::stopping::stop(&mut self.driver);
-        let words = stopped.words::<chassis_protocol::driver::v1::DriverCore>();
-        if stopped.confirmed() {
-            Ok(words)
-        } else {
-            Err(words)
-        }
+        driver.set_velocity(BodyVelocity::new(vx, vy, wz))
     }
 
     fn rotate_rate(&self) -> Result<i32, &'static str> {
         Ok(ROTATE_MRAD_S)
     }
 
-    fn turn(&mut self, _alive: bool) -> Result<String, String> {
+    fn turn(&mut self, _driver: &mut BoardV1, _alive: bool) -> Result<String, String> {
         Err(NO_TURN.into())
     }
 
-    fn follow_up(&mut self) -> Option<String> {
+    fn follow_up(&mut self, _driver: &mut BoardV1) -> Option<String> {
         None
     }
 
-    fn view(&self, status: Status) -> View {
-        let core = self.driver.core();
+    fn view(&self, core: &DriverCore, status: Status) -> View {
         let stats = core.parser_stats();
         View {
             status,
@@ -308,7 +248,8 @@ impl Chassis for BoardV1Chassis {
 /// `chassis monitor [--drive]` on a v1.0.0 board: the keys drive at `speed` mm/s.
 pub fn run(port: &str, drive: bool, speed: i32) -> Result<(), String> {
     crate::monitor::run_monitor(
-        || crate::port::open_v1(port, None).map(BoardV1Chassis::new),
+        || crate::port::open_v1(port, None),
+        BoardV1Chassis,
         drive,
         speed,
     )
@@ -317,10 +258,7 @@ pub fn run(port: &str, drive: bool, speed: i32) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn screen(view: &View) -> String {
-        crate::monitor::screen_text(render, view)
-    }
+    use crate::monitor::testing::*;
 
     fn close(got: Option<f64>, want: f64) {
         let got = got.expect("a yaw");
@@ -351,16 +289,7 @@ mod tests {
     #[test]
     fn the_screen_shows_the_telemetry_the_counters_and_the_keys() {
         let view = View {
-            status: Status {
-                port: "/dev/ttyUSB0".into(),
-                link_alive: true,
-                stale_ms: None,
-                driving: true,
-                held: false,
-                speed: 300,
-                velocity: [0, 300, 0],
-                message: NO_TURN.into(),
-            },
+            status: driving(NO_TURN),
             telemetry: Some(Telemetry {
                 velocity: [-120, 300, 500],
                 accel: [3, -4, 1000],
@@ -374,87 +303,32 @@ mod tests {
             discarded: 17,
             failsafe_stops: 1,
         };
-        let text = screen(&view);
-        for needle in [
-            "chassis monitor",
-            "/dev/ttyUSB0",
-            "LINK UP",
-            "firmware v1.0.0",
-            "vx  -0.120 m/s  vy   0.300 m/s  wz   0.500 rad/s",
-            "yaw    90.0°",
-            "accel raw  x      3  y     -4  z   1000",
-            "gyro raw   x      1  y     -2  z    500",
-            "w   707  x     0  y     0  z   707",
-            "scale unknown",
-            "11.87 V  (11870 mV)",
-            "telemetry       22.2 Hz",
-            "frames good     1203",
-            "bad BCC         4",
-            "bytes discarded 17",
-            "failsafe stops  1",
-            "driving at 0.300 m/s: vx 0.000 vy 0.300 m/s, wz 0.000 rad/s",
-            "no turn by an angle on v1.0.0",
-            "z/x rotate 0.5 rad/s",
-            "space forced stop",
-            "q or Ctrl-C quit",
-        ] {
-            assert!(text.contains(needle), "{needle:?} on the screen:\n{text}");
-        }
-        assert!(!text.contains("t turn"), "no turn key on v1.0.0:\n{text}");
-    }
-
-    #[test]
-    fn a_board_gone_quiet_shows_stale_figures_and_the_hold() {
-        let text = screen(&View {
-            status: Status {
-                port: "/dev/ttyUSB0".into(),
-                stale_ms: Some(3_200),
-                driving: true,
-                held: true,
-                ..Status::default()
-            },
-            telemetry: Some(Telemetry {
-                battery_mv: 12_000,
-                quaternion: [1000, 0, 0, 0],
-                ..Telemetry::default()
-            }),
-            rate_millihertz: 22_000,
-            failsafe_stops: 1,
-            ..View::default()
-        });
-        for needle in [
-            "NO LINK",
-            "STALE 3.2 s",
-            "measured (stale)",
-            "telemetry       stale",
-            "stopped by the failsafe: press a key",
-            "failsafe stops  1",
-            "12.00 V",
-        ] {
-            assert!(text.contains(needle), "{needle:?} on the screen:\n{text}");
-        }
-        assert!(
-            !text.contains("22.0 Hz"),
-            "no rate shown as if live:\n{text}"
+        assert_screen(
+            &screen_text(render, &view),
+            &[
+                "chassis monitor",
+                "/dev/ttyUSB0",
+                "LINK UP",
+                "firmware v1.0.0",
+                "vx  -0.120 m/s  vy   0.300 m/s  wz   0.500 rad/s",
+                "yaw    90.0°",
+                "accel raw  x      3  y     -4  z   1000",
+                "gyro raw   x      1  y     -2  z    500",
+                "w   707  x     0  y     0  z   707",
+                "scale unknown",
+                "11.87 V  (11870 mV)",
+                "telemetry       22.2 Hz",
+                "frames good     1203",
+                "bad BCC         4",
+                "bytes discarded 17",
+                "failsafe stops  1",
+                "driving at 0.300 m/s: vx 0.000 vy 0.300 m/s, wz 0.000 rad/s",
+                "no turn by an angle on v1.0.0",
+                "z/x rotate 0.5 rad/s",
+                "space forced stop",
+                "q or Ctrl-C quit",
+            ],
+            &["t turn"],
         );
-    }
-
-    #[test]
-    fn a_silent_board_shows_no_link_and_waits() {
-        let text = screen(&View {
-            status: Status {
-                port: "/dev/ttyACM0".into(),
-                ..Status::default()
-            },
-            ..View::default()
-        });
-        for needle in [
-            "NO LINK",
-            "waiting for the telemetry",
-            "read only (start with --drive to drive)",
-            "q quit",
-        ] {
-            assert!(text.contains(needle), "{needle:?} on the screen:\n{text}");
-        }
     }
 }

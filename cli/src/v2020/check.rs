@@ -6,35 +6,40 @@
 //! SIGINT, SIGTERM and SIGHUP stop the chassis (a turn cancelled) and end the check.
 
 use super::open;
-use crate::check::{Ending, Session, ending, not_run, stopped_words};
-use crate::stopping::core_words;
+use crate::check::{Session, Steps, driver_words, timing};
 use chassis_bringup::link::Common;
-use chassis_bringup::v2020::{Failure, Link, Plan, Report, Why, bring_up};
-use chassis_bringup::{Check, LinkError, Note, Skip, Timing};
+use chassis_bringup::v2020::{Link, Plan, Report, Why, bring_up};
+use chassis_bringup::{Check, LinkError, Skip};
 use chassis_protocol::driver::host::Heard;
-use chassis_protocol::driver::{DriverCore, Error, Event};
+use chassis_protocol::driver::{DriverCore, Event};
 use chassis_protocol::registers::Snapshot;
 use chassis_protocol::{DriveType, Register, Stream, Turn, Velocity, Write};
-use std::io::Write as _;
-use std::time::Instant;
 
 /// What the check does to a chassis, said before it starts.
 const MOTION: &str = "the chassis will move: forward and sideways for 0.4 s each at speed 300, one 90° turn, then 1.5 s forward at 150. Give it about a metre of clear floor, or lift it so its wheels turn freely";
 
-/// The check's [`Link`]: the host driver, with a progress line per check and an ending (a
-/// signal, the terminal or input gone: [`crate::ending`]) turned into an error at the next
-/// call (the bring-up then stops the chassis itself). A check done keeps what it measured
-/// (`None`: skipped).
-type Checker = Session<DriverCore, Option<String>>;
+/// What the 2020 check says of itself: its nine checks, by their own names.
+impl Steps for DriverCore {
+    type Report = Report;
+    const PASS_NOTE: &str = "";
 
-impl Checker {
-    /// What a check measured, for its progress line.
-    fn detail(&self, check: Check) -> String {
-        let core = self.inner_core();
+    fn checks() -> impl Iterator<Item = Check> {
+        Check::ALL.into_iter()
+    }
+
+    fn name(check: Check) -> &'static str {
+        check.name()
+    }
+
+    fn telemetry(event: &Event) -> bool {
+        matches!(event, Event::Telemetry(_))
+    }
+
+    fn detail(session: &Checker, check: Check, seconds: f64) -> String {
+        let core = Common::core(session);
         match check {
             Check::Link => {
                 let frames = |s: Stream| core.stream(s).frames;
-                let seconds = self.step.elapsed().as_secs_f64();
                 format!(
                     "{} IMU, {} encoder, {} battery frames in {seconds:.1} s",
                     frames(Stream::Imu),
@@ -54,10 +59,28 @@ impl Checker {
         }
     }
 
-    fn inner_core(&self) -> &DriverCore {
-        Common::core(&self.inner)
+    fn skipped(why: Skip) -> &'static str {
+        match why {
+            Skip::NoMotion => "--no-motion",
+            Skip::DriveTypeKept => "the board's own kept: --drive-type sets one",
+            Skip::NoSideways => "a differential chassis does not move sideways",
+            Skip::NoEncoders => "no encoders on an open-loop differential chassis",
+        }
+    }
+
+    fn found(check: Check, said: &str, report: &Report) -> String {
+        passed_detail(check, said, report)
+    }
+
+    fn counted(report: &Report) -> String {
+        format!("telemetry frames missed: {}", report.missed)
     }
 }
+
+/// The check's [`Link`]: the host driver, with a progress line per check and an ending (a
+/// signal, the terminal or input gone: [`crate::ending`]) turned into an error at the next
+/// call (the bring-up then stops the chassis itself).
+type Checker = Session<DriverCore>;
 
 impl Link for Checker {
     fn set_velocity(&mut self, velocity: Velocity) -> Result<(), LinkError> {
@@ -86,72 +109,10 @@ impl Link for Checker {
     }
 }
 
-impl Common for Checker {
-    type Core = DriverCore;
-    type Event = Event;
-    fn now_ms(&mut self) -> u64 {
-        self.inner.now_ms()
-    }
-    fn core(&self) -> &DriverCore {
-        self.inner_core()
-    }
-    fn poll(&mut self) -> Result<Option<Event>, LinkError> {
-        self.go_on()?;
-        self.inner.poll()
-    }
-    fn stop(&mut self) -> Result<(), LinkError> {
-        Session::stop(self, Common::stop)
-    }
-    fn note(&mut self, note: Note) {
-        let index = |c: Check| Check::ALL.iter().position(|x| *x == c).unwrap_or(0) + 1;
-        let mut out = std::io::stdout().lock();
-        match note {
-            Note::Start(check) => {
-                self.step = Instant::now();
-                self.current = Some(check);
-                let _ = write!(out, "[{}/9] {:<13}", index(check), check.name());
-            }
-            Note::Passed(check) => {
-                let detail = self.detail(check);
-                let _ = writeln!(
-                    out,
-                    "ok    {:>4.1} s  {detail}",
-                    self.step.elapsed().as_secs_f64(),
-                );
-                self.done.push((check, Some(detail)));
-                self.current = None;
-            }
-            Note::Skipped(check, why) => {
-                let _ = writeln!(
-                    out,
-                    "[{}/9] {:<13}skipped ({})",
-                    index(check),
-                    check.name(),
-                    match why {
-                        Skip::NoMotion => "--no-motion",
-                        Skip::DriveTypeKept => "the board's own kept: --drive-type sets one",
-                        Skip::NoSideways => "a differential chassis does not move sideways",
-                        Skip::NoEncoders => "no encoders on an open-loop differential chassis",
-                    }
-                );
-                self.done.push((check, None));
-            }
-        }
-        let _ = out.flush();
-    }
-}
-
 /// Why a check failed, in words.
-fn why(failure: &Failure, heard: Heard, port: &str) -> String {
-    match failure.why {
-        Why::Driver(Error::Transport(embedded_io::ErrorKind::Interrupted)) => {
-            "interrupted".into()
-        }
-        Why::Driver(Error::Core(e)) => core_words(e, heard, port),
-        Why::Driver(Error::Transport(kind)) => format!(
-            "the serial port failed ({kind:?}): was the adapter unplugged, or the board's power cut?"
-        ),
-        Why::Driver(e) => format!("the driver failed: {e:?}"),
+fn why(why: Why, heard: Heard, port: &str) -> String {
+    match why {
+        Why::Driver(e) => driver_words(e, heard, port),
         Why::Rate(stream, per_10s) if heard == Heard::Nothing => format!(
             "no telemetry ({stream:?} {:.1} Hz): is the board powered, TX wired to RX and RX to TX, at 115200 bps?",
             f64::from(per_10s) / 10.0
@@ -182,42 +143,6 @@ fn why(failure: &Failure, heard: Heard, port: &str) -> String {
             "the board went quiet: the driver's failsafe stopped the chassis".into()
         }
     }
-}
-
-/// The verdict of a passed check, one line per check.
-fn verdict(
-    report: &Report,
-    done: &[(Check, Option<String>)],
-    motion: bool,
-    seconds: f64,
-) -> String {
-    let passed = done.iter().filter(|(_, s)| s.is_some()).count();
-    let skipped = done.len() - passed;
-    let mut lines = vec![format!(
-        "PASS: {passed} checks passed{} in {seconds:.1} s",
-        if skipped > 0 {
-            format!(", {skipped} skipped")
-        } else {
-            String::new()
-        }
-    )];
-    for (check, state) in done {
-        let detail = match state {
-            None => "skipped".to_string(),
-            Some(frames) => passed_detail(*check, frames, report),
-        };
-        lines.push(format!("  {:<13} {detail}", check.name()));
-    }
-    lines.push(format!(
-        "  telemetry frames missed: {}; {}",
-        report.missed,
-        if motion {
-            "the chassis is stopped"
-        } else {
-            "nothing moved, nothing was written"
-        }
-    ));
-    lines.join("\n")
 }
 
 /// What a passed check found, for its line of the verdict (`frames`: what the link check
@@ -274,51 +199,12 @@ pub fn check(
         }
     );
     let plan = Plan {
-        timing: Timing {
-            motion: !no_motion,
-            ..Timing::DEFAULT
-        },
+        timing: timing(no_motion),
         drive,
         ..Plan::DEFAULT
     };
     let result = bring_up(&mut link, &plan);
-    let seconds = link.start.elapsed().as_secs_f64();
-    match result {
-        Ok(report) => {
-            say!("\n{}", verdict(&report, &link.done, !no_motion, seconds));
-            Ok(())
-        }
-        Err(failure) => Err(failed_line(&mut link, failure, path, no_motion)),
-    }
-}
-
-/// The failure's line and exit status: why the check failed, what the stop after it did, the
-/// checks not run.
-fn failed_line(link: &mut Checker, failure: Failure, path: &str, no_motion: bool) -> (String, u8) {
-    let now = link.now_ms();
-    let heard = link.core().heard(now);
-    let stopped = stopped_words(link.last_stop.take(), no_motion, false, |e| {
-        why(
-            &Failure {
-                check: failure.check,
-                why: Why::Driver(e),
-            },
-            heard,
-            path,
-        )
-    });
-    ending(Ending {
-        check: failure.check.name(),
-        under_way: link.current.is_some(),
-        not_run: not_run(
-            Check::ALL,
-            failure.check,
-            &link.done,
-            no_motion,
-            Check::name,
-        ),
-        stopped,
-        why: why(&failure, heard, path),
-        code: u8::try_from(failure.check.exit_code()).unwrap_or(1),
+    link.conclude(result, no_motion, path, |reason, heard| {
+        why(reason, heard, path)
     })
 }

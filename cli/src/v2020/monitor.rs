@@ -1,12 +1,13 @@
 //! `chassis monitor` on a board running the 2020 firmware: its screen ([`View`], [`render`]) and
-//! its [`Chassis`] (the driver, the gyro Z history, the reads of a turn's pending angle). The
-//! keys, the failsafe's hold, the link and the terminal are shared ([`crate::monitor`]).
+//! its [`Chassis`] (the gyro Z history, the reads of a turn's pending angle). The driver, the
+//! keys, the failsafe's hold, the link, the screen's title and keys lines and the terminal are
+//! shared ([`crate::monitor`]).
 
 use super::{explain, open};
-use crate::monitor::{Chassis, Status, drive_panel, keys_bar, rate_text, run_monitor, title_bar};
+use crate::monitor::{Chassis, Status, drive_panel, rate_text, run_monitor, screen_frame};
 use crate::port::Board;
-use crate::stopping;
-use chassis_protocol::driver::{CoreError, Error, Event as DriverEvent};
+use chassis_protocol::driver::host::SerialError;
+use chassis_protocol::driver::{CoreError, DriverCore, Error, Event as DriverEvent};
 use chassis_protocol::{Battery, Downlink, Encoders, Imu, Lock, Stream, Velocity};
 use ratatui::Frame;
 use ratatui::layout::{Constraint, Layout, Rect};
@@ -61,27 +62,19 @@ pub struct View {
 /// Draws the 2020 board's whole screen.
 pub fn render(frame: &mut Frame<'_>, view: &View) {
     let status = &view.status;
-    let [title, body, keys] = Layout::vertical([
-        Constraint::Length(1),
-        Constraint::Min(10),
-        Constraint::Length(3),
-    ])
-    .areas(frame.area());
     let lock = match view.lock {
         Some(Lock::Locked) => "locked",
         Some(Lock::Tentative) => "tentative",
         Some(Lock::Hunting) | None => "hunting",
     };
-    title_bar(
+    let body = screen_frame(
         frame,
-        title,
-        &status.port,
-        status.link_alive,
-        status.stale_ms,
+        status,
         format!(
             "  failsafe stops {}  parser {lock}, {} bytes discarded",
             view.failsafe_stops, view.discarded
         ),
+        "arrows/WASD drive  space stop  t turn 90° once  +/- speed  q or Ctrl-C quit",
     );
     let [left, right] =
         Layout::horizontal([Constraint::Percentage(55), Constraint::Percentage(45)]).areas(body);
@@ -97,8 +90,7 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
     drive_panel(
         frame,
         drive_area,
-        status.driving,
-        status.held,
+        status,
         format!(
             "driving at {}: x {} y {} z {}{}",
             status.speed,
@@ -107,13 +99,6 @@ pub fn render(frame: &mut Frame<'_>, view: &View) {
             status.velocity[2],
             if view.turning { "  (turning)" } else { "" }
         ),
-        &status.message,
-    );
-    keys_bar(
-        frame,
-        keys,
-        status.driving,
-        "arrows/WASD drive  space stop  t turn 90° once  +/- speed  q or Ctrl-C quit",
     );
 }
 
@@ -240,19 +225,17 @@ fn render_imu(frame: &mut Frame<'_>, area: Rect, view: &View) {
     );
 }
 
-/// The 2020 board under the monitor: its driver, the gyro Z history, the next read of a
-/// turn's pending angle.
+/// The 2020 board under the monitor: the gyro Z history, the next read of a turn's pending
+/// angle.
 pub struct Board2020 {
-    driver: Board,
     history: VecDeque<i16>,
     next_turn_read: Instant,
 }
 
 impl Board2020 {
-    /// The board behind `driver`.
-    pub fn new(driver: Board) -> Self {
+    /// No history yet.
+    pub fn new() -> Self {
         Board2020 {
-            driver,
             history: VecDeque::with_capacity(HISTORY),
             next_turn_read: Instant::now(),
         }
@@ -260,60 +243,31 @@ impl Board2020 {
 }
 
 impl Chassis for Board2020 {
+    type Core = DriverCore;
     type View = View;
 
-    fn port(&self) -> &str {
-        self.driver.uart().name()
-    }
-
-    fn poll(&mut self) -> Result<bool, String> {
-        match self.driver.poll() {
-            Ok(Some(DriverEvent::Telemetry(Downlink::Imu(imu)))) => {
-                if self.history.len() == HISTORY {
-                    self.history.pop_front();
-                }
-                self.history.push_back(imu.gyro[2]);
-                Ok(true)
+    fn took(&mut self, event: &DriverEvent) {
+        if let DriverEvent::Telemetry(Downlink::Imu(imu)) = event {
+            if self.history.len() == HISTORY {
+                self.history.pop_front();
             }
-            Ok(Some(_)) => Ok(true),
-            Ok(None) => Ok(false),
-            Err(e) => Err(explain(&self.driver, e)),
+            self.history.push_back(imu.gyro[2]);
         }
     }
 
-    fn failsafe_stops(&self) -> u32 {
-        self.driver.core().failsafe_stops()
-    }
-
-    fn drive(&mut self, [x, y, z]: [i32; 3]) -> Result<(), String> {
-        self.driver
-            .set_velocity(Velocity::new(x, y, z))
-            .map_err(|e| explain(&self.driver, e))
-    }
-
-    fn stop(&mut self) -> Result<(), String> {
-        self.driver.stop().map_err(|e| explain(&self.driver, e))
-    }
-
-    fn stop_on_exit(&mut self) -> Result<String, String> {
-        let stopped = stopping::stop(&mut self.driver);
-        let words = stopped.words::<chassis_protocol::driver::DriverCore>();
-        if stopped.confirmed() {
-            Ok(words)
-        } else {
-            Err(words)
-        }
+    fn drive(&self, driver: &mut Board, [x, y, z]: [i32; 3]) -> Result<(), Error<SerialError>> {
+        driver.set_velocity(Velocity::new(x, y, z))
     }
 
     fn rotate_rate(&self) -> Result<i32, &'static str> {
         Err("no rotate keys on the 2020 firmware: t turns 90°")
     }
 
-    fn turn(&mut self, alive: bool) -> Result<String, String> {
+    fn turn(&mut self, driver: &mut Board, alive: bool) -> Result<String, String> {
         if !alive {
             return Err("no link: not turning".into());
         }
-        match self.driver.turn_by(900) {
+        match driver.turn_by(900) {
             Ok(()) => {
                 self.next_turn_read = Instant::now() + TURN_READ;
                 Ok("turning 90° (sent once)".into())
@@ -321,23 +275,22 @@ impl Chassis for Board2020 {
             Err(Error::Core(CoreError::TurnInProgress)) => {
                 Err("a turn is still going: not sent again".into())
             }
-            Err(e) => Err(explain(&self.driver, e)),
+            Err(e) => Err(explain(driver, e)),
         }
     }
 
-    fn follow_up(&mut self) -> Option<String> {
-        if self.driver.core().turning() && Instant::now() >= self.next_turn_read {
+    fn follow_up(&mut self, driver: &mut Board) -> Option<String> {
+        if driver.core().turning() && Instant::now() >= self.next_turn_read {
             self.next_turn_read = Instant::now() + TURN_READ;
             // A read lost is tried again at the next one.
-            if self.driver.turn_remaining().is_ok() && !self.driver.core().turning() {
+            if driver.turn_remaining().is_ok() && !driver.core().turning() {
                 return Some("turn done".into());
             }
         }
         None
     }
 
-    fn view(&self, status: Status) -> View {
-        let core = self.driver.core();
+    fn view(&self, core: &DriverCore, status: Status) -> View {
         let mut streams = [StreamView::default(); 3];
         for s in Stream::ALL {
             let info = core.stream(s);
@@ -374,30 +327,18 @@ impl Chassis for Board2020 {
 
 /// `chassis monitor [--drive]` on a 2020 board.
 pub fn run(port: &str, drive: bool, speed: i32) -> Result<(), String> {
-    run_monitor(|| open(port).map(Board2020::new), drive, speed)
+    run_monitor(|| open(port), Board2020::new(), drive, speed)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn screen(view: &View) -> String {
-        crate::monitor::screen_text(render, view)
-    }
+    use crate::monitor::testing::*;
 
     #[test]
     fn the_screen_shows_every_stream_the_link_and_the_keys() {
         let view = View {
-            status: Status {
-                port: "/dev/ttyUSB0".into(),
-                link_alive: true,
-                stale_ms: None,
-                driving: true,
-                held: false,
-                speed: 300,
-                velocity: [0, 300, 0],
-                message: "turning 90° (sent once)".into(),
-            },
+            status: driving("turning 90° (sent once)"),
             lock: Some(Lock::Locked),
             imu: Some(Imu {
                 accel: [12, -7, 16_384],
@@ -435,79 +376,29 @@ mod tests {
             gyro_z: vec![3, 232, 450],
             turning: true,
         };
-        let text = screen(&view);
-        for needle in [
-            "chassis monitor",
-            "/dev/ttyUSB0",
-            "LINK UP",
-            "parser locked, 17 bytes discarded",
-            "failsafe stops 0",
-            "accel  x     12  y     -7  z  16384",
-            "gyro   x     -3  y      2  z    450   count 41",
-            "M1    120  M2   -118  M3    121  M4   -119",
-            "11.87 V  76 %",
-            "100.0 Hz",
-            "1203",
-            "25.0 Hz",
-            "1.0 Hz",
-            "peak 450",
-            "driving at 300: x 0 y 300 z 0  (turning)",
-            "turning 90° (sent once)",
-            "t turn 90° once",
-            "q or Ctrl-C quit",
-        ] {
-            assert!(text.contains(needle), "{needle:?} on the screen:\n{text}");
-        }
-    }
-
-    #[test]
-    fn a_silent_board_shows_no_link_and_waits() {
-        let text = screen(&View {
-            status: Status {
-                port: "/dev/ttyACM0".into(),
-                ..Status::default()
-            },
-            ..View::default()
-        });
-        assert!(text.contains("NO LINK"), "{text}");
-        assert!(text.contains("waiting for the IMU"), "{text}");
-        assert!(
-            text.contains("read only (start with --drive to drive)"),
-            "{text}"
-        );
-        assert!(text.contains("q quit"), "{text}");
-    }
-
-    #[test]
-    fn a_board_gone_quiet_shows_stale_figures_and_the_hold() {
-        let text = screen(&View {
-            status: Status {
-                port: "/dev/ttyUSB0".into(),
-                stale_ms: Some(3_200),
-                driving: true,
-                held: true,
-                ..Status::default()
-            },
-            streams: [StreamView {
-                rate_millihertz: 100_000,
-                frames: 50,
-                missed: 0,
-            }; 3],
-            failsafe_stops: 1,
-            ..View::default()
-        });
-        for needle in [
-            "NO LINK",
-            "STALE 3.2 s",
-            "stale",
-            "stopped by the failsafe: press a key",
-            "failsafe stops 1",
-        ] {
-            assert!(text.contains(needle), "{needle:?} on the screen:\n{text}");
-        }
-        assert!(
-            !text.contains("100.0 Hz"),
-            "no rate shown as if live:\n{text}"
+        assert_screen(
+            &screen_text(render, &view),
+            &[
+                "chassis monitor",
+                "/dev/ttyUSB0",
+                "LINK UP",
+                "parser locked, 17 bytes discarded",
+                "failsafe stops 0",
+                "accel  x     12  y     -7  z  16384",
+                "gyro   x     -3  y      2  z    450   count 41",
+                "M1    120  M2   -118  M3    121  M4   -119",
+                "11.87 V  76 %",
+                "100.0 Hz",
+                "1203",
+                "25.0 Hz",
+                "1.0 Hz",
+                "peak 450",
+                "driving at 300: x 0 y 300 z 0  (turning)",
+                "turning 90° (sent once)",
+                "t turn 90° once",
+                "q or Ctrl-C quit",
+            ],
+            &[],
         );
     }
 }

@@ -1,8 +1,13 @@
-//! What the CLI's edge tests share: a simulated board on a real pseudo-terminal that records
-//! every byte it is sent and can go silent, a terminal for the commands that need one, and the
-//! spec's stop frame.
+//! What the CLI's tests share: a simulated board on a real pseudo-terminal that records every
+//! byte it is sent and can go silent, a terminal for the commands that need one, and the spec's
+//! stop frame; the golden captures and their decoding ([`decoding`]); the v1.0.0 board and its
+//! frames ([`v1`]); the monitor's failsafe hold ([`monitor`]).
 
 #![allow(dead_code)]
+
+pub mod decoding;
+pub mod monitor;
+pub mod v1;
 
 use chassis_protocol::sim::{Board, Faults, Motion, SimConfig, Simulated, serve};
 use chassis_protocol::{Command, UplinkParser};
