@@ -376,14 +376,23 @@ fn run(index: usize, ending: Ending, moment_ms: u64, dir: &std::path::Path) -> O
     let to_exit = ended_at.elapsed();
     match &mut started {
         Started::Terminal(term) if ending != Ending::TerminalClosed => {
-            // The last words reach the terminal just after the exit.
-            // The last words reach the terminal just after the exit: read until they are there
-            // (the message starts with "chassis"), or a second has passed (a loaded machine).
-            let until = Instant::now() + Duration::from_secs(1);
+            // The last words reach the terminal just after the exit: read until the words the
+            // ending calls for are there (a screen that names the chassis is not them), or
+            // three seconds have passed (a loaded machine).
+            let until = Instant::now() + Duration::from_secs(3);
+            let awaited = match ending {
+                Ending::Signal(name, _) => format!("interrupted by SIG{name}"),
+                _ => "standard input ended".to_string(),
+            };
             loop {
                 said = term.written();
-                let tail = said.rsplit(['\n', '\r']).find(|l| !l.trim().is_empty());
-                if tail.is_some_and(|l| l.contains("chassis")) || Instant::now() > until {
+                let clean = harness::strip_escapes(&said);
+                // A process the signal itself ended says nothing.
+                let silent = status.code().is_none();
+                if ended_first || silent || clean.contains(&awaited) || Instant::now() > until {
+                    break;
+                }
+                if case.records && clean.contains("recorded") {
                     break;
                 }
                 std::thread::sleep(Duration::from_millis(10));
