@@ -10,6 +10,7 @@ pub mod channel;
 pub mod qemu;
 pub mod score;
 pub mod splice;
+pub mod sweep;
 pub mod v1;
 
 pub use board::{BoardStream, CountModel, Gap, Payload, Read, SentFrame, reads_behind};
