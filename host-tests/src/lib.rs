@@ -8,6 +8,7 @@
 pub mod board;
 pub mod channel;
 pub mod qemu;
+mod replies;
 pub mod score;
 pub mod splice;
 pub mod sweep;
