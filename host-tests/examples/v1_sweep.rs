@@ -12,44 +12,11 @@
 //! expects and what the plausibility check catches, the share of untouched frames recovered
 //! (goal ≥ 99.9 % at 1e-3); then the parser's own counters, and the worst row of each figure.
 
+use chassis_host_tests::sweep::Args;
 use chassis_host_tests::v1::expect::{undetected_reply, undetected_telemetry};
 use chassis_host_tests::v1::{Score, rows, run, run_reporting_quiet, startup};
 use std::process::ExitCode;
 use std::time::Instant;
-
-struct Args {
-    seed: u64,
-    frames: usize,
-}
-
-fn parse_args() -> Result<Args, String> {
-    let mut args = Args {
-        seed: 2026,
-        frames: 1_000_000,
-    };
-    let mut it = std::env::args().skip(1);
-    while let Some(flag) = it.next() {
-        let mut value = |name: &str| {
-            it.next()
-                .ok_or_else(|| format!("{name} needs a value"))?
-                .replace('_', "")
-                .parse::<u64>()
-                .map_err(|e| format!("{name}: {e}"))
-        };
-        match flag.as_str() {
-            "--seed" => args.seed = value("--seed")?,
-            "--frames" => {
-                args.frames = usize::try_from(value("--frames")?).map_err(|e| e.to_string())?
-            }
-            "-h" | "--help" => return Err("usage: v1_sweep [--seed N] [--frames N]".to_string()),
-            other => return Err(format!("unknown argument {other:?}; try --help")),
-        }
-    }
-    if args.frames == 0 {
-        return Err("--frames must be at least 1".to_string());
-    }
-    Ok(args)
-}
 
 /// `n` with a space every three digits.
 fn grouped(n: usize) -> String {
@@ -65,12 +32,8 @@ fn grouped(n: usize) -> String {
 }
 
 fn main() -> ExitCode {
-    let args = match parse_args() {
-        Ok(args) => args,
-        Err(message) => {
-            eprintln!("v1_sweep: {message}");
-            return ExitCode::from(2);
-        }
+    let Some(args) = Args::from_env("v1_sweep", "usage: v1_sweep [--seed N] [--frames N]") else {
+        return ExitCode::from(2);
     };
     println!(
         "v1.0.0 board → master: {} frames per row (telemetry 22 Hz, a reply a second, the line idle between frames), seed {}\n",

@@ -6,6 +6,7 @@
 //! line between them: the hardest case for resynchronisation, since a quiet line would mark
 //! every boundary.
 
+use crate::replies::Replies;
 use chassis_protocol::{Battery, Downlink, Encoders, Imu, Register, Reply};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -116,9 +117,7 @@ pub struct BoardStream {
     next_imu_us: u64,
     next_encoders_us: u64,
     next_battery_us: u64,
-    next_reply_us: u64,
-    /// Mean microseconds between replies (0: none).
-    reply_every_us: u64,
+    replies: Replies,
     seq: [u8; 3],
     wheel_speed: [i16; 4],
     wheel_total: [i16; 4],
@@ -129,11 +128,6 @@ impl BoardStream {
     /// A board that starts at a random phase, with `replies_per_second` replies on average.
     pub fn new(seed: u64, replies_per_second: f64) -> Self {
         let mut rng = Pcg64Mcg::seed_from_u64(seed);
-        let reply_every_us = if replies_per_second > 0.0 {
-            (1e6 / replies_per_second) as u64
-        } else {
-            0
-        };
         let seq = [rng.random(), rng.random(), rng.random()];
         BoardStream {
             payload: Payload::Rest,
@@ -142,12 +136,7 @@ impl BoardStream {
             next_imu_us: rng.random_range(0..10_000),
             next_encoders_us: rng.random_range(0..40_000),
             next_battery_us: rng.random_range(0..1_000_000),
-            next_reply_us: if reply_every_us > 0 {
-                rng.random_range(0..reply_every_us)
-            } else {
-                u64::MAX
-            },
-            reply_every_us,
+            replies: Replies::new(&mut rng, replies_per_second),
             rng,
             now_us: 0,
             seq,
@@ -271,7 +260,7 @@ impl BoardStream {
             .next_imu_us
             .min(self.next_encoders_us)
             .min(self.next_battery_us)
-            .min(self.next_reply_us);
+            .min(self.replies.next_us());
         let quiet_us = due.saturating_sub(self.now_us);
         self.now_us = self.now_us.max(due);
         let frame = if due == self.next_imu_us {
@@ -284,10 +273,7 @@ impl BoardStream {
             self.next_battery_us += 1_000_000;
             self.battery()
         } else {
-            let gap = self
-                .rng
-                .random_range(self.reply_every_us / 2..=self.reply_every_us * 3 / 2);
-            self.next_reply_us += gap.max(1);
+            self.replies.sent(&mut self.rng);
             self.reply()
         };
         // 86.8 us per byte at 115 200 bps, 8N1.

@@ -8,8 +8,10 @@
 pub mod board;
 pub mod channel;
 pub mod qemu;
+mod replies;
 pub mod score;
 pub mod splice;
+pub mod sweep;
 pub mod v1;
 
 pub use board::{BoardStream, CountModel, Gap, Payload, Read, SentFrame, reads_behind};

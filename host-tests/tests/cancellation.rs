@@ -11,7 +11,7 @@
 
 use chassis_protocol::driver::asynch::Driver as AsyncDriver;
 use chassis_protocol::driver::blocking::Driver;
-use chassis_protocol::driver::{Config, Error, TurnState, reg};
+use chassis_protocol::driver::{Config, Core, DriverCore, Error, TurnState, reg};
 use chassis_protocol::sim::{Board, FACTORY, SimClock, SimConfig, SimDelay, SimUart, Simulated};
 use chassis_protocol::{Action, Motors, Velocity, Write};
 use core::cell::Cell;
@@ -225,7 +225,137 @@ impl<B: Simulated> embedded_io_async::Write for Choppy<'_, B> {
     }
 }
 
-// ----- the calls -----
+// ----- the calls, cut -----
+
+type Boxed<'a> = Pin<Box<dyn Future<Output = Result<(), Error<Cut>>> + 'a>>;
+/// `G`'s async driver over the choppy UART.
+type AsyncOf<'t, G> = AsyncDriver<
+    Choppy<'t, <G as Generation>::Board>,
+    SimClock<'t>,
+    SimDelay<'t>,
+    <G as Generation>::Core,
+>;
+/// `G`'s blocking driver over the choppy UART.
+type BlockingOf<'t, G> =
+    Driver<Choppy<'t, <G as Generation>::Board>, SimClock<'t>, <G as Generation>::Core>;
+
+/// A firmware generation as the cut tests drive it: its simulated board and driver core, the
+/// calls under test, what is done before a call and after its cut, and the judge of what the
+/// board received.
+trait Generation: Sized {
+    type Board: Simulated;
+    type Core: Core;
+    type Call: Copy + core::fmt::Debug + 'static;
+    /// What the driver showed after the cut (its state, what it read back), for the judge.
+    type Seen;
+    /// Stands before the call's name in the messages.
+    const PREFIX: &'static str;
+    /// The calls under test.
+    const CALLS: &'static [Self::Call];
+
+    /// A board just powered up.
+    fn board() -> Self::Board;
+    /// A new driver core.
+    fn core() -> Self::Core;
+    /// What the async driver is put through before `call` (nothing unless said).
+    fn prepare_async(_d: &mut AsyncOf<'_, Self>, _call: Self::Call) {}
+    /// What the blocking driver is put through before `call` (nothing unless said).
+    fn prepare_blocking(_d: &mut BlockingOf<'_, Self>, _call: Self::Call, _time: &Cell<u64>) {}
+    /// `call`, as a future to cut.
+    fn call_async<'a>(d: &'a mut AsyncOf<'_, Self>, call: Self::Call) -> Boxed<'a>;
+    /// `call`, run to its end or to a transport error.
+    fn call_blocking(d: &mut BlockingOf<'_, Self>, call: Self::Call) -> Result<(), Error<Cut>>;
+    /// After the cut: what the driver had committed, then a stop and a read, which must work.
+    fn follow_up_async(d: &mut AsyncOf<'_, Self>, what: &str) -> Self::Seen;
+    /// The same on the blocking driver.
+    fn follow_up_blocking(d: &mut BlockingOf<'_, Self>, what: &str, time: &Cell<u64>)
+    -> Self::Seen;
+    /// Judges what `uart`'s board received after `call` was cut and followed up; the call's
+    /// bytes began at `before`.
+    fn judge(
+        call: Self::Call,
+        what: &str,
+        uart: &Choppy<'_, Self::Board>,
+        before: usize,
+        seen: Self::Seen,
+    );
+}
+
+/// Runs `cut_at(n)` for n = 0, 1, 2, … (polls, or bytes taken) until the call it cuts ran to
+/// its end before the cut (`cut_at` returns true): how many runs that took. `what` names the
+/// call.
+fn every_cut_point(what: &str, mut cut_at: impl FnMut(usize) -> bool) -> usize {
+    let mut n = 0;
+    loop {
+        if cut_at(n) {
+            return n + 1;
+        }
+        assert!(n < 20_000, "{what}: never finished");
+        n += 1;
+    }
+}
+
+/// Every call of `G`'s async driver cut at every await point (dropped after 0, 1, 2, … polls,
+/// as a `select` that another branch won would), once for each UART in `chunks` (the bytes it
+/// takes a write), each on a new board, followed up and judged: how many cut points.
+fn cut_every_async_call<G: Generation>(chunks: [usize; 2]) -> usize {
+    let mut cuts = 0;
+    for chunk in chunks {
+        for &call in G::CALLS {
+            let name = format!("{}{call:?}", G::PREFIX);
+            cuts += every_cut_point(&format!("{name}, {chunk}-byte writes"), |polls| {
+                let time = Cell::new(0);
+                let uart = Choppy::with(G::board(), &time, chunk);
+                let mut d: AsyncOf<'_, G> =
+                    AsyncDriver::from_core(uart, SimClock(&time), SimDelay(&time), G::core());
+                G::prepare_async(&mut d, call);
+                let before = d.uart().wire.len();
+                let finished = {
+                    let mut future = G::call_async(&mut d, call);
+                    let mut cx = Context::from_waker(Waker::noop());
+                    (0..polls).any(|_| future.as_mut().poll(&mut cx).is_ready())
+                    // Dropped here, wherever it was.
+                };
+                let what = format!("{name} after {polls} polls, {chunk}-byte writes");
+                let seen = G::follow_up_async(&mut d, &what);
+                G::judge(call, &what, d.uart(), before, seen);
+                finished
+            });
+        }
+    }
+    cuts
+}
+
+/// Every call of `G`'s blocking driver cut by a transport error after every byte count (the
+/// UART takes 3 bytes a write and fails once the count is reached), each on a new board,
+/// followed up and judged: how many cut points.
+fn cut_every_blocking_call<G: Generation>() -> usize {
+    let mut cuts = 0;
+    for &call in G::CALLS {
+        let name = format!("{}{call:?}", G::PREFIX);
+        cuts += every_cut_point(&name, |at| {
+            let time = Cell::new(0);
+            let uart = Choppy::with(G::board(), &time, 3);
+            let mut d: BlockingOf<'_, G> = Driver::from_core(uart, SimClock(&time), G::core());
+            G::prepare_blocking(&mut d, call, &time);
+            let before = d.uart().wire.len();
+            d.uart_mut().fail_at = Some(before + at);
+            let result = G::call_blocking(&mut d, call);
+            let cut = d.uart().fail_at.is_none();
+            d.uart_mut().fail_at = None;
+            if cut {
+                assert_eq!(result, Err(Error::Transport(Cut)), "{name} cut at {at}");
+            }
+            let what = format!("{name} cut at byte {at}");
+            let seen = G::follow_up_blocking(&mut d, &what, &time);
+            G::judge(call, &what, d.uart(), before, seen);
+            !cut
+        });
+    }
+    cuts
+}
+
+// ----- the 2020 board -----
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Call {
@@ -245,95 +375,172 @@ enum Call {
     Poll,
 }
 
-const CALLS: [Call; 14] = [
-    Call::SetVelocity,
-    Call::SetMotors,
-    Call::Turn,
-    Call::TurnOnANewDriver,
-    Call::StopWhileTurning,
-    Call::Read,
-    Call::ReadVerified,
-    Call::ReadRaw,
-    Call::TurnRemaining,
-    Call::Write,
-    Call::Action,
-    Call::ReadSettings,
-    Call::RestoreSettings,
-    Call::Poll,
-];
+type Async<'t> = AsyncOf<'t, V2020>;
+type Blocking<'t> = BlockingOf<'t, V2020>;
 
-type Async<'t> = AsyncDriver<Choppy<'t>, SimClock<'t>, SimDelay<'t>>;
-type Blocking<'t> = Driver<Choppy<'t>, SimClock<'t>>;
-type Boxed<'a> = Pin<Box<dyn Future<Output = Result<(), Error<Cut>>> + 'a>>;
+/// The 2020 firmware, over `DriverCore`.
+struct V2020;
 
-fn call_async<'a>(d: &'a mut Async<'_>, call: Call) -> Boxed<'a> {
-    match call {
-        Call::SetVelocity => Box::pin(d.set_velocity(Velocity::new(0, 300, 0))),
-        Call::SetMotors => Box::pin(d.set_motors(Motors::closed_loop([100, -100, 100, -100]))),
-        Call::Turn | Call::TurnOnANewDriver => Box::pin(d.turn_by(900)),
-        Call::StopWhileTurning => Box::pin(d.stop()),
-        Call::Read => Box::pin(async { d.read(reg::MaxSpeed).await.map(|_| ()) }),
-        Call::ReadVerified => Box::pin(async { d.read_verified(reg::GyroGain).await.map(|_| ()) }),
-        Call::ReadRaw => Box::pin(async {
-            d.read_raw(chassis_protocol::Register::SpeedKp)
-                .await
-                .map(|_| ())
-        }),
-        Call::TurnRemaining => Box::pin(async { d.turn_remaining().await.map(|_| ()) }),
-        Call::Write => Box::pin(d.write(Write::MaxSpeed(800))),
-        Call::Action => Box::pin(d.action(Action::Store)),
-        Call::ReadSettings => Box::pin(async { d.read_settings().await.map(|_| ()) }),
-        Call::RestoreSettings => Box::pin(d.restore_settings(&FACTORY)),
-        Call::Poll => Box::pin(async { d.poll().await.map(|_| ()) }),
-    }
+/// What the 2020 driver showed after the cut.
+struct Seen2020 {
+    /// Whether the driver had committed the call's turn when it was cut.
+    turn_committed: bool,
+    /// Max speed, read after the stop.
+    max_speed_read: u16,
 }
 
-fn call_blocking(d: &mut Blocking<'_>, call: Call) -> Result<(), Error<Cut>> {
-    match call {
-        Call::SetVelocity => d.set_velocity(Velocity::new(0, 300, 0)),
-        Call::SetMotors => d.set_motors(Motors::closed_loop([100, -100, 100, -100])),
-        Call::Turn | Call::TurnOnANewDriver => d.turn_by(900),
-        Call::StopWhileTurning => d.stop(),
-        Call::Read => d.read(reg::MaxSpeed).map(|_| ()),
-        Call::ReadVerified => d.read_verified(reg::GyroGain).map(|_| ()),
-        Call::ReadRaw => d.read_raw(chassis_protocol::Register::SpeedKp).map(|_| ()),
-        Call::TurnRemaining => d.turn_remaining().map(|_| ()),
-        Call::Write => d.write(Write::MaxSpeed(800)),
-        Call::Action => d.action(Action::Store),
-        Call::ReadSettings => d.read_settings().map(|_| ()),
-        Call::RestoreSettings => d.restore_settings(&FACTORY),
-        Call::Poll => d.poll().map(|_| ()),
-    }
+/// Whether the driver had committed the call's turn (90.0°).
+fn turn_committed(core: &DriverCore) -> bool {
+    matches!(core.turn_state(), TurnState::Turning { deci_degrees: 900 })
 }
 
-/// What a driver is put through before the call under test: the pending angle read (so a
-/// turn may go), and for a stop, a turn to cancel.
-fn prepare_async(d: &mut Async<'_>, call: Call) {
-    if call == Call::TurnOnANewDriver {
-        return;
+impl Generation for V2020 {
+    type Board = Board;
+    type Core = DriverCore;
+    type Call = Call;
+    type Seen = Seen2020;
+    const PREFIX: &'static str = "";
+    const CALLS: &'static [Call] = &[
+        Call::SetVelocity,
+        Call::SetMotors,
+        Call::Turn,
+        Call::TurnOnANewDriver,
+        Call::StopWhileTurning,
+        Call::Read,
+        Call::ReadVerified,
+        Call::ReadRaw,
+        Call::TurnRemaining,
+        Call::Write,
+        Call::Action,
+        Call::ReadSettings,
+        Call::RestoreSettings,
+        Call::Poll,
+    ];
+
+    fn board() -> Board {
+        Board::new(SimConfig::default())
     }
-    embassy_futures::block_on(d.turn_remaining()).unwrap();
-    if call == Call::StopWhileTurning {
-        embassy_futures::block_on(d.turn_by(900)).unwrap();
+
+    fn core() -> DriverCore {
+        DriverCore::new(Config::DEFAULT)
+    }
+
+    /// The pending angle read (so a turn may go), and for a stop, a turn to cancel.
+    fn prepare_async(d: &mut Async<'_>, call: Call) {
+        if call == Call::TurnOnANewDriver {
+            return;
+        }
+        embassy_futures::block_on(d.turn_remaining()).unwrap();
+        if call == Call::StopWhileTurning {
+            embassy_futures::block_on(d.turn_by(900)).unwrap();
+            embassy_futures::block_on(async {
+                for _ in 0..30 {
+                    d.poll().await.unwrap();
+                }
+            });
+        }
+    }
+
+    fn prepare_blocking(d: &mut Blocking<'_>, call: Call, time: &Cell<u64>) {
+        if call == Call::TurnOnANewDriver {
+            return;
+        }
+        d.turn_remaining().unwrap();
+        if call == Call::StopWhileTurning {
+            d.turn_by(900).unwrap();
+            let until = time.get() + 300;
+            while time.get() < until {
+                d.poll().unwrap();
+            }
+        }
+    }
+
+    fn call_async<'a>(d: &'a mut Async<'_>, call: Call) -> Boxed<'a> {
+        match call {
+            Call::SetVelocity => Box::pin(d.set_velocity(Velocity::new(0, 300, 0))),
+            Call::SetMotors => Box::pin(d.set_motors(Motors::closed_loop([100, -100, 100, -100]))),
+            Call::Turn | Call::TurnOnANewDriver => Box::pin(d.turn_by(900)),
+            Call::StopWhileTurning => Box::pin(d.stop()),
+            Call::Read => Box::pin(async { d.read(reg::MaxSpeed).await.map(|_| ()) }),
+            Call::ReadVerified => {
+                Box::pin(async { d.read_verified(reg::GyroGain).await.map(|_| ()) })
+            }
+            Call::ReadRaw => Box::pin(async {
+                d.read_raw(chassis_protocol::Register::SpeedKp)
+                    .await
+                    .map(|_| ())
+            }),
+            Call::TurnRemaining => Box::pin(async { d.turn_remaining().await.map(|_| ()) }),
+            Call::Write => Box::pin(d.write(Write::MaxSpeed(800))),
+            Call::Action => Box::pin(d.action(Action::Store)),
+            Call::ReadSettings => Box::pin(async { d.read_settings().await.map(|_| ()) }),
+            Call::RestoreSettings => Box::pin(d.restore_settings(&FACTORY)),
+            Call::Poll => Box::pin(async { d.poll().await.map(|_| ()) }),
+        }
+    }
+
+    fn call_blocking(d: &mut Blocking<'_>, call: Call) -> Result<(), Error<Cut>> {
+        match call {
+            Call::SetVelocity => d.set_velocity(Velocity::new(0, 300, 0)),
+            Call::SetMotors => d.set_motors(Motors::closed_loop([100, -100, 100, -100])),
+            Call::Turn | Call::TurnOnANewDriver => d.turn_by(900),
+            Call::StopWhileTurning => d.stop(),
+            Call::Read => d.read(reg::MaxSpeed).map(|_| ()),
+            Call::ReadVerified => d.read_verified(reg::GyroGain).map(|_| ()),
+            Call::ReadRaw => d.read_raw(chassis_protocol::Register::SpeedKp).map(|_| ()),
+            Call::TurnRemaining => d.turn_remaining().map(|_| ()),
+            Call::Write => d.write(Write::MaxSpeed(800)),
+            Call::Action => d.action(Action::Store),
+            Call::ReadSettings => d.read_settings().map(|_| ()),
+            Call::RestoreSettings => d.restore_settings(&FACTORY),
+            Call::Poll => d.poll().map(|_| ()),
+        }
+    }
+
+    fn follow_up_async(d: &mut Async<'_>, what: &str) -> Seen2020 {
+        let turn_committed = turn_committed(d.core());
+        embassy_futures::block_on(d.stop()).unwrap_or_else(|e| panic!("{what}: stop: {e:?}"));
+        let max_speed_read = embassy_futures::block_on(d.read(reg::MaxSpeed))
+            .unwrap_or_else(|e| panic!("{what}: read after: {e:?}"));
+        // Let the board finish what it was told (a counter-turn's last degrees).
         embassy_futures::block_on(async {
-            for _ in 0..30 {
+            for _ in 0..200 {
                 d.poll().await.unwrap();
             }
         });
+        Seen2020 {
+            turn_committed,
+            max_speed_read,
+        }
     }
-}
 
-fn prepare_blocking(d: &mut Blocking<'_>, call: Call, time: &Cell<u64>) {
-    if call == Call::TurnOnANewDriver {
-        return;
-    }
-    d.turn_remaining().unwrap();
-    if call == Call::StopWhileTurning {
-        d.turn_by(900).unwrap();
+    fn follow_up_blocking(d: &mut Blocking<'_>, what: &str, time: &Cell<u64>) -> Seen2020 {
+        let turn_committed = turn_committed(d.core());
+        d.stop().unwrap_or_else(|e| panic!("{what}: stop: {e:?}"));
+        let max_speed_read = d
+            .read(reg::MaxSpeed)
+            .unwrap_or_else(|e| panic!("{what}: read after: {e:?}"));
         let until = time.get() + 300;
         while time.get() < until {
             d.poll().unwrap();
         }
+        Seen2020 {
+            turn_committed,
+            max_speed_read,
+        }
+    }
+
+    fn judge(call: Call, what: &str, uart: &Choppy<'_>, before: usize, seen: Seen2020) {
+        Verdict {
+            call,
+            what,
+            wire: &uart.wire,
+            before,
+            turn_committed: seen.turn_committed,
+            board: uart.uart.board(),
+            max_speed_read: seen.max_speed_read,
+        }
+        .check();
     }
 }
 
@@ -351,28 +558,7 @@ struct Verdict<'a> {
     max_speed_read: u16,
 }
 
-impl<'a> Verdict<'a> {
-    /// Judges what `uart`'s board received after `call` was cut and followed up.
-    fn judge(
-        call: Call,
-        what: &'a str,
-        uart: &'a Choppy<'_>,
-        before: usize,
-        turn_committed: bool,
-        max_speed_read: u16,
-    ) {
-        Verdict {
-            call,
-            what,
-            wire: &uart.wire,
-            before,
-            turn_committed,
-            board: uart.uart.board(),
-            max_speed_read,
-        }
-        .check();
-    }
-
+impl Verdict<'_> {
     fn check(&self) {
         let what = self.what;
         let frames = frames(self.wire).unwrap_or_else(|e| panic!("{what}: {e}"));
@@ -429,113 +615,15 @@ impl<'a> Verdict<'a> {
     }
 }
 
-/// After the cut: stop, then a read of max speed; both must work.
-fn follow_up_async(d: &mut Async<'_>, what: &str) -> u16 {
-    embassy_futures::block_on(d.stop()).unwrap_or_else(|e| panic!("{what}: stop: {e:?}"));
-    let speed = embassy_futures::block_on(d.read(reg::MaxSpeed))
-        .unwrap_or_else(|e| panic!("{what}: read after: {e:?}"));
-    // Let the board finish what it was told (a counter-turn's last degrees).
-    embassy_futures::block_on(async {
-        for _ in 0..200 {
-            d.poll().await.unwrap();
-        }
-    });
-    speed
-}
-
 #[test]
 fn every_async_call_cut_at_every_await_point_leaves_only_whole_frames_and_a_working_driver() {
-    let mut cuts = 0;
-    for chunk in [1, 3] {
-        for call in CALLS {
-            for polls in 0.. {
-                let time = Cell::new(0);
-                let uart = Choppy::new(&time, chunk);
-                let mut d = Async::new(uart, SimClock(&time), SimDelay(&time), Config::DEFAULT);
-                prepare_async(&mut d, call);
-                let before = d.uart().wire.len();
-                let mut cx = Context::from_waker(Waker::noop());
-                let finished = {
-                    let mut future = call_async(&mut d, call);
-                    let mut finished = false;
-                    for _ in 0..polls {
-                        if future.as_mut().poll(&mut cx).is_ready() {
-                            finished = true;
-                            break;
-                        }
-                    }
-                    finished
-                    // Dropped here, wherever it was.
-                };
-                let turn_committed = matches!(
-                    d.core().turn_state(),
-                    TurnState::Turning { deci_degrees: 900 }
-                );
-                let what = format!("{call:?} after {polls} polls, {chunk}-byte writes");
-                let max_speed_read = follow_up_async(&mut d, &what);
-                Verdict::judge(
-                    call,
-                    &what,
-                    d.uart(),
-                    before,
-                    turn_committed,
-                    max_speed_read,
-                );
-                cuts += 1;
-                if finished {
-                    break;
-                }
-                assert!(polls < 20_000, "{what}: never finished");
-            }
-        }
-    }
+    let cuts = cut_every_async_call::<V2020>([1, 3]);
     assert!(cuts > 600, "{cuts} cut points");
 }
 
 #[test]
 fn every_blocking_call_cut_by_a_transport_error_after_every_byte_leaves_only_whole_frames() {
-    let mut cuts = 0;
-    for call in CALLS {
-        for at in 0.. {
-            let time = Cell::new(0);
-            let uart = Choppy::new(&time, 3);
-            let mut d = Blocking::new(uart, SimClock(&time), Config::DEFAULT);
-            prepare_blocking(&mut d, call, &time);
-            let before = d.uart().wire.len();
-            d.uart_mut().fail_at = Some(before + at);
-            let result = call_blocking(&mut d, call);
-            let cut = d.uart().fail_at.is_none();
-            d.uart_mut().fail_at = None;
-            if cut {
-                assert_eq!(result, Err(Error::Transport(Cut)), "{call:?} cut at {at}");
-            }
-            let turn_committed = matches!(
-                d.core().turn_state(),
-                TurnState::Turning { deci_degrees: 900 }
-            );
-            let what = format!("{call:?} cut at byte {at}");
-            d.stop().unwrap_or_else(|e| panic!("{what}: stop: {e:?}"));
-            let max_speed_read = d
-                .read(reg::MaxSpeed)
-                .unwrap_or_else(|e| panic!("{what}: read after: {e:?}"));
-            let until = time.get() + 300;
-            while time.get() < until {
-                d.poll().unwrap();
-            }
-            Verdict::judge(
-                call,
-                &what,
-                d.uart(),
-                before,
-                turn_committed,
-                max_speed_read,
-            );
-            cuts += 1;
-            if !cut {
-                break;
-            }
-        }
-    }
+    let cuts = cut_every_blocking_call::<V2020>();
     assert!(cuts > 100, "{cuts} cut points");
 }
 
@@ -657,16 +745,6 @@ mod v1_board {
         Poll,
     }
 
-    const CALLS: [Call; 7] = [
-        Call::SetVelocity,
-        Call::SetMotors,
-        Call::Readback,
-        Call::Geometry,
-        Call::WriteSettings,
-        Call::Stop,
-        Call::Poll,
-    ];
-
     const WIDER: Geometry = Geometry {
         wheel_spacing_mm: 120,
         axle_spacing_mm: 110,
@@ -674,145 +752,132 @@ mod v1_board {
         wheel_diameter_mm: 60,
     };
 
-    type Async<'t> = AsyncDriver<Choppy<'t, V1Board>, SimClock<'t>, SimDelay<'t>, DriverCore>;
-    type Blocking<'t> = Driver<Choppy<'t, V1Board>, SimClock<'t>, DriverCore>;
+    /// The v1.0.0 firmware, over `driver::v1::DriverCore`.
+    struct V1;
 
-    fn call_async<'a>(d: &'a mut Async<'_>, call: Call) -> Boxed<'a> {
-        match call {
-            Call::SetVelocity => Box::pin(d.set_velocity(BodyVelocity::new(0, 300, 0))),
-            Call::SetMotors => Box::pin(d.set_motors(MotorVelocity::new([100, -100, 100, -100]))),
-            Call::Readback => {
-                Box::pin(async { d.readback(Readback::MotorSpeeds).await.map(|_| ()) })
+    impl Generation for V1 {
+        type Board = V1Board;
+        type Core = DriverCore;
+        type Call = Call;
+        /// The wheel spacing read back after the stop.
+        type Seen = u16;
+        const PREFIX: &'static str = "v1 ";
+        const CALLS: &'static [Call] = &[
+            Call::SetVelocity,
+            Call::SetMotors,
+            Call::Readback,
+            Call::Geometry,
+            Call::WriteSettings,
+            Call::Stop,
+            Call::Poll,
+        ];
+
+        fn board() -> V1Board {
+            V1Board::new(V1Config::default())
+        }
+
+        fn core() -> DriverCore {
+            DriverCore::new(Config::DEFAULT)
+        }
+
+        fn call_async<'a>(d: &'a mut AsyncOf<'_, V1>, call: Call) -> Boxed<'a> {
+            match call {
+                Call::SetVelocity => Box::pin(d.set_velocity(BodyVelocity::new(0, 300, 0))),
+                Call::SetMotors => {
+                    Box::pin(d.set_motors(MotorVelocity::new([100, -100, 100, -100])))
+                }
+                Call::Readback => {
+                    Box::pin(async { d.readback(Readback::MotorSpeeds).await.map(|_| ()) })
+                }
+                Call::Geometry => {
+                    Box::pin(async { d.readback(Readback::Geometry).await.map(|_| ()) })
+                }
+                Call::WriteSettings => Box::pin(d.write_settings(Settings::Geometry(WIDER))),
+                Call::Stop => Box::pin(d.stop()),
+                Call::Poll => Box::pin(async { d.poll().await.map(|_| ()) }),
             }
-            Call::Geometry => Box::pin(async { d.readback(Readback::Geometry).await.map(|_| ()) }),
-            Call::WriteSettings => Box::pin(d.write_settings(Settings::Geometry(WIDER))),
-            Call::Stop => Box::pin(d.stop()),
-            Call::Poll => Box::pin(async { d.poll().await.map(|_| ()) }),
         }
-    }
 
-    fn call_blocking(d: &mut Blocking<'_>, call: Call) -> Result<(), Error<Cut>> {
-        match call {
-            Call::SetVelocity => d.set_velocity(BodyVelocity::new(0, 300, 0)),
-            Call::SetMotors => d.set_motors(MotorVelocity::new([100, -100, 100, -100])),
-            Call::Readback => d.readback(Readback::MotorSpeeds).map(|_| ()),
-            Call::Geometry => d.geometry().map(|_| ()),
-            Call::WriteSettings => d.write_settings(Settings::Geometry(WIDER)),
-            Call::Stop => d.stop(),
-            Call::Poll => d.poll().map(|_| ()),
+        fn call_blocking(d: &mut BlockingOf<'_, V1>, call: Call) -> Result<(), Error<Cut>> {
+            match call {
+                Call::SetVelocity => d.set_velocity(BodyVelocity::new(0, 300, 0)),
+                Call::SetMotors => d.set_motors(MotorVelocity::new([100, -100, 100, -100])),
+                Call::Readback => d.readback(Readback::MotorSpeeds).map(|_| ()),
+                Call::Geometry => d.geometry().map(|_| ()),
+                Call::WriteSettings => d.write_settings(Settings::Geometry(WIDER)),
+                Call::Stop => d.stop(),
+                Call::Poll => d.poll().map(|_| ()),
+            }
         }
-    }
 
-    /// Judges what the board received: only whole frames, each one the board executed; the
-    /// settings write reached it whole or not at all (the readback after says which); a
-    /// forced stop after the call and only readbacks after it; the chassis still at the end.
-    fn judge(what: &str, uart: &Choppy<'_, V1Board>, before: usize, wheel_spacing_read: u16) {
-        let frames = frames(&uart.wire).unwrap_or_else(|e| panic!("{what}: {e}"));
-        let board = uart.uart.board();
-        assert_eq!(
-            board.total_commands() as usize,
-            frames.len(),
-            "{what}: the board took another count of frames than whole frames sent"
-        );
-        let wrote = frames.iter().any(|(_, f)| *f == Frame::Geometry);
-        assert_eq!(
-            wheel_spacing_read,
-            if wrote { 120 } else { 110 },
-            "{what}: the geometry read back"
-        );
-        let last_stop = frames
-            .iter()
-            .rposition(|(_, f)| *f == Frame::Stop)
-            .unwrap_or_else(|| panic!("{what}: no forced stop after the call"));
-        for (at, f) in &frames[last_stop + 1..] {
-            assert!(
-                matches!(f, Frame::Readback(_)),
-                "{what}: {f:?} at byte {at} after the stop"
+        fn follow_up_async(d: &mut AsyncOf<'_, V1>, what: &str) -> u16 {
+            embassy_futures::block_on(d.stop()).unwrap_or_else(|e| panic!("{what}: stop: {e:?}"));
+            embassy_futures::block_on(d.readback(Readback::Geometry))
+                .unwrap_or_else(|e| panic!("{what}: read after: {e:?}"))
+                .geometry()
+                .unwrap()
+                .wheel_spacing_mm
+        }
+
+        fn follow_up_blocking(d: &mut BlockingOf<'_, V1>, what: &str, _time: &Cell<u64>) -> u16 {
+            d.stop().unwrap_or_else(|e| panic!("{what}: stop: {e:?}"));
+            d.geometry()
+                .unwrap_or_else(|e| panic!("{what}: read after: {e:?}"))
+                .wheel_spacing_mm
+        }
+
+        /// Judges what the board received: only whole frames, each one the board executed; the
+        /// settings write reached it whole or not at all (the readback after says which); a
+        /// forced stop after the call and only readbacks after it; the chassis still at the
+        /// end.
+        fn judge(
+            _call: Call,
+            what: &str,
+            uart: &Choppy<'_, V1Board>,
+            before: usize,
+            wheel_spacing_read: u16,
+        ) {
+            let frames = frames(&uart.wire).unwrap_or_else(|e| panic!("{what}: {e}"));
+            let board = uart.uart.board();
+            assert_eq!(
+                board.total_commands() as usize,
+                frames.len(),
+                "{what}: the board took another count of frames than whole frames sent"
             );
+            let wrote = frames.iter().any(|(_, f)| *f == Frame::Geometry);
+            assert_eq!(
+                wheel_spacing_read,
+                if wrote { 120 } else { 110 },
+                "{what}: the geometry read back"
+            );
+            let last_stop = frames
+                .iter()
+                .rposition(|(_, f)| *f == Frame::Stop)
+                .unwrap_or_else(|| panic!("{what}: no forced stop after the call"));
+            for (at, f) in &frames[last_stop + 1..] {
+                assert!(
+                    matches!(f, Frame::Readback(_)),
+                    "{what}: {f:?} at byte {at} after the stop"
+                );
+            }
+            assert!(
+                before.is_multiple_of(14),
+                "{what}: the call's bytes do not start on a frame boundary"
+            );
+            assert_eq!(board.velocity(), BodyVelocity::FORCED_STOP, "{what}");
         }
-        assert!(
-            before.is_multiple_of(14),
-            "{what}: the call's bytes do not start on a frame boundary"
-        );
-        assert_eq!(board.velocity(), BodyVelocity::FORCED_STOP, "{what}");
     }
 
     #[test]
     fn every_v1_async_call_cut_at_every_await_point_leaves_only_whole_frames_and_a_working_driver()
     {
-        let mut cuts = 0;
-        for chunk in [1, 5] {
-            for call in CALLS {
-                for polls in 0.. {
-                    let time = Cell::new(0);
-                    let board = V1Board::new(V1Config::default());
-                    let uart = Choppy::with(board, &time, chunk);
-                    let mut d =
-                        Async::new_v1(uart, SimClock(&time), SimDelay(&time), Config::DEFAULT);
-                    let before = d.uart().wire.len();
-                    let mut cx = Context::from_waker(Waker::noop());
-                    let finished = {
-                        let mut future = call_async(&mut d, call);
-                        let mut finished = false;
-                        for _ in 0..polls {
-                            if future.as_mut().poll(&mut cx).is_ready() {
-                                finished = true;
-                                break;
-                            }
-                        }
-                        finished
-                    };
-                    let what = format!("v1 {call:?} after {polls} polls, {chunk}-byte writes");
-                    embassy_futures::block_on(d.stop())
-                        .unwrap_or_else(|e| panic!("{what}: stop: {e:?}"));
-                    let geometry = embassy_futures::block_on(d.readback(Readback::Geometry))
-                        .unwrap_or_else(|e| panic!("{what}: read after: {e:?}"))
-                        .geometry()
-                        .unwrap();
-                    judge(&what, d.uart(), before, geometry.wheel_spacing_mm);
-                    cuts += 1;
-                    if finished {
-                        break;
-                    }
-                    assert!(polls < 20_000, "{what}: never finished");
-                }
-            }
-        }
+        let cuts = cut_every_async_call::<V1>([1, 5]);
         assert!(cuts > 100, "{cuts} cut points");
     }
 
     #[test]
     fn every_v1_blocking_call_cut_by_a_transport_error_after_every_byte_leaves_only_whole_frames() {
-        let mut cuts = 0;
-        for call in CALLS {
-            for at in 0.. {
-                let time = Cell::new(0);
-                let uart = Choppy::with(V1Board::new(V1Config::default()), &time, 3);
-                let mut d = Blocking::new_v1(uart, SimClock(&time), Config::DEFAULT);
-                let before = d.uart().wire.len();
-                d.uart_mut().fail_at = Some(before + at);
-                let result = call_blocking(&mut d, call);
-                let cut = d.uart().fail_at.is_none();
-                d.uart_mut().fail_at = None;
-                if cut {
-                    assert_eq!(
-                        result,
-                        Err(Error::Transport(Cut)),
-                        "v1 {call:?} cut at {at}"
-                    );
-                }
-                let what = format!("v1 {call:?} cut at byte {at}");
-                d.stop().unwrap_or_else(|e| panic!("{what}: stop: {e:?}"));
-                let geometry = d
-                    .geometry()
-                    .unwrap_or_else(|e| panic!("{what}: read after: {e:?}"));
-                judge(&what, d.uart(), before, geometry.wheel_spacing_mm);
-                cuts += 1;
-                if !cut {
-                    break;
-                }
-            }
-        }
+        let cuts = cut_every_blocking_call::<V1>();
         assert!(cuts > 50, "{cuts} cut points");
     }
 }

@@ -84,6 +84,78 @@ fn reads(sent: &[Sent]) -> Vec<Register> {
         .collect()
 }
 
+/// The firmware's log, decoded; it must name every one of `steps`.
+fn log_naming<B: Served>(run: &Run<B>, steps: &[&str]) -> String {
+    let log = qemu::decode_log(&firmware(), &run.log).expect("defmt-print decodes the log");
+    for step in steps {
+        assert!(log.contains(step), "the log has {step:?}:\n{log}");
+    }
+    log
+}
+
+/// The RAM the log reports ("RAM: 24 B static + 1900 B stack at its peak": the stack is painted
+/// at boot), static and stack, which must fit 8 KiB.
+fn ram_fits(log: &str) -> (usize, usize) {
+    let line = log
+        .lines()
+        .find(|l| l.contains("RAM: "))
+        .expect("the firmware reports its RAM");
+    let numbers: Vec<usize> = line
+        .split_whitespace()
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    let [static_ram, stack] = numbers[..] else {
+        panic!("unexpected RAM line {line:?}");
+    };
+    eprintln!("RAM: {static_ram} B static + {stack} B stack");
+    assert!(
+        static_ram + stack <= 8 * 1024,
+        "the firmware fits 8 KiB of RAM: {static_ram} + {stack}"
+    );
+    (static_ram, stack)
+}
+
+/// Every check passed; else fails with `what` and the firmware's log.
+fn assert_passed<B: Served>(run: &Run<B>, what: &str) {
+    if run.exit_code() != Some(0) {
+        let log = qemu::decode_log(&firmware(), &run.log).unwrap_or_default();
+        panic!(
+            "{what}: every check passes, not {:?}:\n{log}",
+            run.exit_code()
+        );
+    }
+}
+
+/// After the board went silent, the failsafe sent `stop` (the frame `is_stop` picks) within
+/// `failsafe_ms` of the silence, plus 60 ms of the emulator's and the host's latency (the
+/// failsafe counts from the last frame heard, before the silence), and nothing moved the
+/// chassis after it.
+fn assert_failsafe_stop<B: Served>(
+    run: &Run<B>,
+    failsafe_ms: u64,
+    stop: &str,
+    is_stop: impl Fn(&B::Command) -> bool,
+) {
+    let silent = run.silenced_at_ms.expect("the board went silent");
+    let sent = run
+        .sent
+        .iter()
+        .find(|s| s.at_ms >= silent && is_stop(&s.command))
+        .unwrap_or_else(|| panic!("{stop} was sent after the silence"));
+    let after = sent.at_ms - silent;
+    eprintln!("silent at {silent} ms, {stop} sent {after} ms later");
+    assert!(
+        after <= failsafe_ms + 60,
+        "stopped {after} ms after the board went silent"
+    );
+    assert!(
+        !run.sent
+            .iter()
+            .any(|s| s.at_ms > sent.at_ms && B::moves(&s.command)),
+        "nothing moves the chassis after the failsafe's {stop}"
+    );
+}
+
 #[test]
 #[ignore = "needs the firmware and qemu-system-arm: cargo xtask test"]
 fn normal_bring_up_reads_every_register_turns_once_and_ends_stopped() {
@@ -121,42 +193,25 @@ fn normal_bring_up_reads_every_register_turns_once_and_ends_stopped() {
 #[test]
 #[ignore = "needs the firmware and qemu-system-arm: cargo xtask test"]
 fn the_log_names_every_check_and_the_ram_used_fits_the_budget() {
-    let run = normal();
-    let log = qemu::decode_log(&firmware(), &run.log).expect("defmt-print decodes the log");
-    for step in [
-        "[link] up",
-        "[settings] Snapshot",
-        "[settings] postcard",
-        "[Forward] encoders counted",
-        "[Strafe] encoders counted",
-        "[turn] done",
-        "[stop] encoders still",
-        "[battery]",
-        "[control-loop]",
-        "PASS",
-    ] {
-        assert!(log.contains(step), "the log has {step:?}:\n{log}");
-    }
-    // "RAM: 24 B static + 1900 B stack at its peak": the stack is painted at boot.
-    let line = log
-        .lines()
-        .find(|l| l.contains("RAM: "))
-        .expect("the firmware reports its RAM");
-    let numbers: Vec<usize> = line
-        .split_whitespace()
-        .filter_map(|w| w.parse().ok())
-        .collect();
-    let [static_ram, stack] = numbers[..] else {
-        panic!("unexpected RAM line {line:?}");
-    };
-    eprintln!("RAM: {static_ram} B static + {stack} B stack");
+    let log = log_naming(
+        normal(),
+        &[
+            "[link] up",
+            "[settings] Snapshot",
+            "[settings] postcard",
+            "[Forward] encoders counted",
+            "[Strafe] encoders counted",
+            "[turn] done",
+            "[stop] encoders still",
+            "[battery]",
+            "[control-loop]",
+            "PASS",
+        ],
+    );
+    let (_, stack) = ram_fits(&log);
     assert!(
         stack > 256,
         "the stack measurement measures something: {stack}"
-    );
-    assert!(
-        static_ram + stack <= 8 * 1024,
-        "the firmware fits 8 KiB of RAM: {static_ram} + {stack}"
     );
 }
 
@@ -216,25 +271,9 @@ fn a_board_going_silent_mid_motion_is_stopped_within_the_failsafe_limit() {
         matches!(code, Some(FORWARD | STRAFE)),
         "the motion check fails: {code:?}"
     );
-    let silent = run.silenced_at_ms.expect("the board went silent");
-    let stop = run
-        .sent
-        .iter()
-        .find(|s| s.at_ms >= silent && is_stop(&s.command))
-        .expect("a stop was sent after the silence");
-    let after = stop.at_ms - silent;
-    eprintln!("silent at {silent} ms, stop sent {after} ms later");
-    // The failsafe (100 ms) plus the emulator's and the host's latency.
-    assert!(
-        after <= u64::from(Config::DEFAULT.failsafe_ms) + 60,
-        "stopped {after} ms after the board went silent"
-    );
-    assert!(
-        !run.sent
-            .iter()
-            .any(|s| s.at_ms > stop.at_ms && is_motion(&s.command)),
-        "nothing moves the chassis after the failsafe stop"
-    );
+    // The failsafe: 100 ms.
+    let failsafe_ms = u64::from(Config::DEFAULT.failsafe_ms);
+    assert_failsafe_stop(&run, failsafe_ms, "a stop", is_stop);
 }
 
 #[test]
@@ -283,13 +322,7 @@ fn a_line_with_one_error_in_a_thousand_bytes_still_brings_up() {
             },
             ..Scenario::default()
         });
-        if run.exit_code() != Some(0) {
-            let log = qemu::decode_log(&firmware(), &run.log).unwrap_or_default();
-            panic!(
-                "seed {seed}: every check passes, not {:?}:\n{log}",
-                run.exit_code()
-            );
-        }
+        assert_passed(&run, &format!("seed {seed}"));
         let turns = run
             .sent
             .iter()
@@ -320,10 +353,7 @@ fn motion_frames(sent: &[Sent<V1Command>]) -> impl Iterator<Item = &Sent<V1Comma
 #[ignore = "needs the firmware and qemu-system-arm: cargo xtask test"]
 fn v1_board_bring_up_passes_and_ends_with_the_forced_stop() {
     let run = normal_v1();
-    if run.exit_code() != Some(0) {
-        let log = qemu::decode_log(&firmware(), &run.log).unwrap_or_default();
-        panic!("every check passes, not {:?}:\n{log}", run.exit_code());
-    }
+    assert_passed(run, "v1.0.0");
     let stats = run.board.uplink_stats();
     assert_eq!(
         (
@@ -388,41 +418,25 @@ fn v1_board_bring_up_passes_and_ends_with_the_forced_stop() {
 #[test]
 #[ignore = "needs the firmware and qemu-system-arm: cargo xtask test"]
 fn v1_log_names_the_firmware_and_every_check_and_the_ram_fits() {
-    let run = normal_v1();
-    let log = qemu::decode_log(&firmware(), &run.log).expect("defmt-print decodes the log");
-    for step in [
-        "firmware v1.0.0",
-        "[link] up",
-        "[settings] SystemSettings",
-        "[settings] Geometry",
-        "[settings] Pid",
-        "[Forward] commanded 300 mm/s",
-        "[Strafe] commanded 300 mm/s",
-        "[turn] rotated at 1000 mrad/s",
-        "[stop] forced stop: still",
-        "[battery]",
-        "[control-loop]",
-        "PASS: every check passed (v1.0.0)",
-    ] {
-        assert!(log.contains(step), "the log has {step:?}:\n{log}");
-    }
-    assert!(!log.contains("[drive-type]"), "no drive type on v1.0.0");
-    let line = log
-        .lines()
-        .find(|l| l.contains("RAM: "))
-        .expect("the firmware reports its RAM");
-    let numbers: Vec<usize> = line
-        .split_whitespace()
-        .filter_map(|w| w.parse().ok())
-        .collect();
-    let [static_ram, stack] = numbers[..] else {
-        panic!("unexpected RAM line {line:?}");
-    };
-    eprintln!("RAM on v1.0.0: {static_ram} B static + {stack} B stack");
-    assert!(
-        static_ram + stack <= 8 * 1024,
-        "the firmware fits 8 KiB of RAM: {static_ram} + {stack}"
+    let log = log_naming(
+        normal_v1(),
+        &[
+            "firmware v1.0.0",
+            "[link] up",
+            "[settings] SystemSettings",
+            "[settings] Geometry",
+            "[settings] Pid",
+            "[Forward] commanded 300 mm/s",
+            "[Strafe] commanded 300 mm/s",
+            "[turn] rotated at 1000 mrad/s",
+            "[stop] forced stop: still",
+            "[battery]",
+            "[control-loop]",
+            "PASS: every check passed (v1.0.0)",
+        ],
     );
+    assert!(!log.contains("[drive-type]"), "no drive type on v1.0.0");
+    ram_fits(&log);
 }
 
 #[test]
@@ -444,25 +458,8 @@ fn v1_board_going_silent_in_the_control_loop_gets_the_failsafe_forced_stop() {
         log.contains("ControlLoop failed") && log.contains("FailsafeStop"),
         "the failsafe stopped it:\n{log}"
     );
-    let silent = run.silenced_at_ms.expect("the board went silent");
-    let stop = run
-        .sent
-        .iter()
-        .find(|s| s.at_ms >= silent && s.command.encode() == FORCED_STOP)
-        .expect("the forced stop was sent after the silence");
-    let after = stop.at_ms - silent;
-    eprintln!("silent at {silent} ms, forced stop {after} ms later");
-    // The failsafe (the log says it was the failsafe) counts from the last frame heard, before
-    // the silence; plus the emulator's and the host's latency.
-    assert!(
-        after <= V1_FAILSAFE_MS + 60,
-        "stopped {after} ms after the board went silent"
-    );
-    assert!(
-        !run.sent
-            .iter()
-            .any(|s| s.at_ms > stop.at_ms && is_motion_v1(&s.command)),
-        "nothing moves the chassis after the failsafe's forced stop"
-    );
+    assert_failsafe_stop(&run, V1_FAILSAFE_MS, "the forced stop", |c| {
+        c.encode() == FORCED_STOP
+    });
     assert_eq!(run.board.velocity(), BodyVelocity::FORCED_STOP);
 }

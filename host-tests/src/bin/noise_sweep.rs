@@ -13,6 +13,7 @@
 
 use chassis_host_tests::board::simulator_stream;
 use chassis_host_tests::channel::{Noise, transmit};
+use chassis_host_tests::sweep::Args;
 use chassis_host_tests::{
     BoardStream, CountModel, Payload, Score, reads_behind, score_downlink,
     score_downlink_listening, startup, startup_with_idle,
@@ -20,42 +21,6 @@ use chassis_host_tests::{
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use std::process::ExitCode;
-
-struct Args {
-    frames: usize,
-    seed: u64,
-}
-
-fn parse_args() -> Result<Args, String> {
-    let mut args = Args {
-        frames: 1_000_000,
-        seed: 2026,
-    };
-    let mut it = std::env::args().skip(1);
-    while let Some(flag) = it.next() {
-        let mut value = |name: &str| {
-            it.next()
-                .ok_or_else(|| format!("{name} needs a value"))?
-                .replace('_', "")
-                .parse::<u64>()
-                .map_err(|e| format!("{name}: {e}"))
-        };
-        match flag.as_str() {
-            "--frames" => {
-                args.frames = usize::try_from(value("--frames")?).map_err(|e| e.to_string())?
-            }
-            "--seed" => args.seed = value("--seed")?,
-            "-h" | "--help" => {
-                return Err("usage: noise-sweep [--frames N] [--seed S]".to_string());
-            }
-            other => return Err(format!("unknown argument {other:?}; try --help")),
-        }
-    }
-    if args.frames == 0 {
-        return Err("--frames must be at least 1".to_string());
-    }
-    Ok(args)
-}
 
 /// Runs `frames` frames through `noise`, as one stream into one parser.
 fn run(noise: &Noise, frames: usize, seed: u64) -> Score {
@@ -80,12 +45,9 @@ fn print_row(name: &str, rate: f64, s: &Score) {
 }
 
 fn main() -> ExitCode {
-    let args = match parse_args() {
-        Ok(args) => args,
-        Err(message) => {
-            eprintln!("noise-sweep: {message}");
-            return ExitCode::from(2);
-        }
+    let Some(args) = Args::from_env("noise-sweep", "usage: noise-sweep [--frames N] [--seed S]")
+    else {
+        return ExitCode::from(2);
     };
     println!(
         "{} frames per row (IMU 100 Hz, encoders 25 Hz, battery 1 Hz, 2 replies/s), seed {}\n",

@@ -8,6 +8,7 @@
 //! discharges (a fresh pack goes in when it is flat). Time runs at 115 200 bps, 8N1: 11 520
 //! bytes a second, 86.8 µs a byte.
 
+use crate::replies::Replies;
 use chassis_protocol::v1::{Downlink, Readback, Reply, Telemetry};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -72,9 +73,7 @@ pub struct Board {
     now_us: u64,
     next_telemetry_us: u64,
     last_telemetry_us: u64,
-    next_reply_us: u64,
-    /// Mean microseconds between replies (0: none).
-    reply_every_us: u64,
+    replies: Replies,
     /// Commanded vx, vy (mm/s), wz (mrad/s).
     target: [f64; 3],
     /// The chassis' actual vx, vy, wz.
@@ -96,21 +95,11 @@ impl Board {
     /// replies on average (0: none).
     pub fn new(seed: u64, replies_per_second: f64) -> Self {
         let mut rng = Pcg64Mcg::seed_from_u64(seed);
-        let reply_every_us = if replies_per_second > 0.0 {
-            (1e6 / replies_per_second) as u64
-        } else {
-            0
-        };
         Board {
             now_us: 0,
             next_telemetry_us: rng.random_range(0..TELEMETRY_PERIOD_US),
             last_telemetry_us: 0,
-            next_reply_us: if reply_every_us > 0 {
-                rng.random_range(0..reply_every_us)
-            } else {
-                u64::MAX
-            },
-            reply_every_us,
+            replies: Replies::new(&mut rng, replies_per_second),
             target: [0.0; 3],
             actual: [0.0; 3],
             accel: [0.0; 2],
@@ -149,7 +138,7 @@ impl Board {
 
     /// The next frame the board sends, and how long the line was idle before it (µs).
     pub fn next_frame(&mut self) -> (Downlink, u64) {
-        let due = self.next_telemetry_us.min(self.next_reply_us);
+        let due = self.next_telemetry_us.min(self.replies.next_us());
         // A frame due while another is on the line goes right after it.
         let start = due.max(self.now_us);
         let idle_us = start - self.now_us;
@@ -158,8 +147,7 @@ impl Board {
             self.next_telemetry_us += TELEMETRY_PERIOD_US - 750 + jitter;
             Downlink::Telemetry(self.telemetry(start))
         } else {
-            let every = self.reply_every_us;
-            self.next_reply_us += self.rng.random_range(every / 2..=every * 3 / 2).max(1);
+            self.replies.sent(&mut self.rng);
             Downlink::Reply(self.reply())
         };
         self.now_us = start + frame.encode().len() as u64 * 1_000_000 / BYTES_PER_SECOND;

@@ -1,13 +1,7 @@
 //! Puts `memory.x` where the linker finds it and links with cortex-m-rt's and defmt's scripts.
 
-use std::{env, fs, path::PathBuf};
+include!("../link-memory-x.rs");
 
 fn main() {
-    let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
-    fs::write(out.join("memory.x"), include_bytes!("memory.x")).expect("OUT_DIR is writable");
-    println!("cargo:rustc-link-search={}", out.display());
-    println!("cargo:rerun-if-changed=memory.x");
-    println!("cargo:rustc-link-arg-bins=--nmagic");
-    println!("cargo:rustc-link-arg-bins=-Tlink.x");
-    println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
+    link_with_memory_x(include_bytes!("memory.x"), &["link.x", "defmt.x"]);
 }
