@@ -349,7 +349,11 @@ fn run(index: usize, ending: Ending, moment_ms: u64, dir: &std::path::Path) -> O
         Started::Terminal(term) => harness::strip_escapes(&term.written()),
         Started::Piped { .. } => String::new(),
     };
-    let ended_first = started.child().try_wait().unwrap().is_some() || so_far.contains("FAIL");
+    // (A monitor refusing a standard input that is not a terminal ends at once: that is its
+    // answer, judged as such below.)
+    let refused = case.needs_terminal && ending == Ending::InputEnded;
+    let ended_first =
+        !refused && (started.child().try_wait().unwrap().is_some() || so_far.contains("FAIL"));
     let mut said = String::new();
     match (&mut started, ending) {
         (started, Ending::Signal(name, _)) => harness::signal(started.child(), name),
@@ -433,7 +437,6 @@ fn run(index: usize, ending: Ending, moment_ms: u64, dir: &std::path::Path) -> O
         _ => "?".into(),
     };
     // The exit status each ending must give.
-    let refused = case.needs_terminal && ending == Ending::InputEnded;
     let mut expected: Vec<String> = match ending {
         // The refusal's status, or a hangup's when the input had ended before it.
         _ if refused => vec!["1".into(), "129".into()],
