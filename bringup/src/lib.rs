@@ -221,6 +221,13 @@ pub struct Failure<W> {
     pub why: W,
 }
 
+impl<W: From<LinkError>> Failure<W> {
+    /// `check` failed because the driver did (`Why::Driver`): what `map_err` takes.
+    fn driver(check: Check) -> impl Fn(LinkError) -> Self {
+        move |e| failure(check, W::from(e))
+    }
+}
+
 /// `check` failed, and why.
 const fn failure<W>(check: Check, why: W) -> Failure<W> {
     Failure { check, why }

@@ -6,14 +6,9 @@ use super::{Failure, Link, Plan, Report, Why};
 use super::{MIN_TELEMETRY_PER_10S, RAMP_MS, STILL_MM_S, STILL_MRAD_S};
 use super::{STOP_SETTLE_MS, STOP_WATCH_MS};
 use crate::link::listen;
-use crate::{Check, LinkError, Note, failure, per_10s};
+use crate::{Check, Note, failure, per_10s};
 use chassis_protocol::driver::v1::Event;
 use chassis_protocol::v1::{BodyVelocity, Readback};
-
-/// `check` failed because the driver did.
-pub(super) fn fail(check: Check) -> impl Fn(LinkError) -> Failure {
-    move |e| failure(check, Why::Driver(e))
-}
 
 /// 1. Link: the telemetry rate over the listening time.
 #[maybe_async::maybe_async]
@@ -32,7 +27,7 @@ pub(super) async fn link<L: Link>(
         }
     };
     let elapsed = listen(link, listen_ms, count).await;
-    report.telemetry_per_10s = per_10s(frames, elapsed.map_err(fail(Check::Link))?);
+    report.telemetry_per_10s = per_10s(frames, elapsed.map_err(Failure::driver(Check::Link))?);
     if report.telemetry_per_10s < MIN_TELEMETRY_PER_10S {
         log!(
             warn,
@@ -55,7 +50,7 @@ pub(super) async fn link<L: Link>(
 #[maybe_async::maybe_async]
 pub(super) async fn settings<L: Link>(link: &mut L, report: &mut Report) -> Result<(), Failure> {
     link.note(Note::Start(Check::Settings));
-    let settings = fail(Check::Settings);
+    let settings = Failure::driver(Check::Settings);
     let no_reply = |r: Readback| settings(chassis_protocol::driver::Error::Core(no_readback(r)));
     let reply = link.readback(Readback::System).await.map_err(&settings)?;
     report.system = reply.system().ok_or_else(|| no_reply(Readback::System))?;
@@ -166,7 +161,7 @@ pub(super) async fn stop<L: Link>(
     failsafe_before: u32,
 ) -> Result<(), Failure> {
     link.note(Note::Start(Check::Stop));
-    link.stop().await.map_err(fail(Check::Stop))?;
+    link.stop().await.map_err(Failure::driver(Check::Stop))?;
     let ms = STOP_SETTLE_MS.saturating_add(STOP_WATCH_MS);
     let (settle, check) = (STOP_SETTLE_MS, Check::Stop);
     let seen = drive_for(link, plan, None, ms, settle, check, failsafe_before).await?;
@@ -226,7 +221,7 @@ pub(super) async fn control_loop<L: Link>(
     let cruise = Some(BodyVelocity::new(0, plan.speed_mm_s / 2, 0));
     let loop_ms = plan.timing.loop_ms;
     let seen = drive_for(link, plan, cruise, loop_ms, 0, check, failsafe_before).await?;
-    link.stop().await.map_err(fail(check))?;
+    link.stop().await.map_err(Failure::driver(check))?;
     report.loop_per_10s = per_10s(seen.frames, loop_ms);
     if report.loop_per_10s < MIN_TELEMETRY_PER_10S {
         return Err(failure(check, Why::Rate(report.loop_per_10s)));

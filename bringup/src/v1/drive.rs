@@ -1,7 +1,6 @@
 //! A timed drive, as the v1.0.0 checks judge it: the velocity re-sent every command period,
 //! the telemetry frames taken in.
 
-use super::checks::fail;
 use super::yaw::{wrap_mrad, yaw_mrad};
 use super::{Failure, Link, Plan, Why};
 use crate::{Check, failure};
@@ -81,10 +80,12 @@ pub(super) async fn drive_for<L: Link>(
         if let Some(velocity) = velocity {
             if now >= next_send {
                 next_send = now.saturating_add(plan.timing.command_period_ms);
-                link.set_velocity(velocity).await.map_err(fail(check))?;
+                link.set_velocity(velocity)
+                    .await
+                    .map_err(Failure::driver(check))?;
             }
         }
-        if let Some(Event::Telemetry(t)) = link.poll().await.map_err(fail(check))? {
+        if let Some(Event::Telemetry(t)) = link.poll().await.map_err(Failure::driver(check))? {
             if now.saturating_sub(start) >= judge_after_ms {
                 seen.take(&t, now);
             }

@@ -123,6 +123,13 @@ pub enum Why {
     FailsafeStop,
 }
 
+/// A driver error: [`Why::Driver`].
+impl From<LinkError> for Why {
+    fn from(e: LinkError) -> Self {
+        Why::Driver(e)
+    }
+}
+
 /// A failed v1.0.0 check and why.
 pub type Failure = crate::Failure<Why>;
 

@@ -23,11 +23,6 @@ pub fn encode_snapshot<'a>(
     }
 }
 
-/// `check` failed because the driver did.
-pub(super) fn fail(check: Check) -> impl Fn(LinkError) -> Failure {
-    move |e| failure(check, Why::Driver(e))
-}
-
 /// 1. Link up: each stream's frames counted over the listening time.
 #[maybe_async::maybe_async]
 pub(super) async fn link<L: Link>(
@@ -49,7 +44,7 @@ pub(super) async fn link<L: Link>(
         }
     };
     let elapsed = listen(link, listen_ms, count).await;
-    let elapsed = divisor_ms(elapsed.map_err(fail(Check::Link))?);
+    let elapsed = divisor_ms(elapsed.map_err(Failure::driver(Check::Link))?);
     if let Err(why) = rates(counts, elapsed, &mut report.rates_per_10s) {
         log!(
             warn,
@@ -100,8 +95,13 @@ pub(super) async fn settings<L: Link>(
     report: &mut Report,
 ) -> Result<Snapshot, Failure> {
     link.note(Note::Start(Check::Settings));
-    let snapshot = link.read_settings().await.map_err(fail(Check::Settings))?;
-    report.pending_before = pending_angle(link).await.map_err(fail(Check::Settings))?;
+    let snapshot = link
+        .read_settings()
+        .await
+        .map_err(Failure::driver(Check::Settings))?;
+    report.pending_before = pending_angle(link)
+        .await
+        .map_err(Failure::driver(Check::Settings))?;
     report.snapshot = snapshot;
     log!(info, "[settings] {}", snapshot);
     log!(
@@ -147,7 +147,9 @@ pub(super) async fn cancel_pending_turn<L: Link>(
             "[settings] a turn of {} (0.1°) was pending: cancelled",
             pending
         );
-        link.stop().await.map_err(fail(Check::Settings))?;
+        link.stop()
+            .await
+            .map_err(Failure::driver(Check::Settings))?;
     }
     Ok(())
 }
@@ -173,11 +175,11 @@ pub(super) async fn drive_type<L: Link>(
         let mode = snapshot.system_mode.with_drive_type(drive);
         link.write(Write::SystemMode(mode))
             .await
-            .map_err(fail(Check::DriveType))?;
+            .map_err(Failure::driver(Check::DriveType))?;
         let raw = link
             .read_verified(Register::SystemMode)
             .await
-            .map_err(fail(Check::DriveType))?;
+            .map_err(Failure::driver(Check::DriveType))?;
         let read_back = chassis_protocol::SystemMode::from_bits(raw).drive_type();
         if read_back != drive {
             return Err(failure(Check::DriveType, Why::DriveTypeNotSet(read_back)));
@@ -237,10 +239,10 @@ pub(super) async fn turn<L: Link>(
     failsafe_before: u32,
 ) -> Result<(), Failure> {
     link.note(Note::Start(Check::Turn));
-    link.stop().await.map_err(fail(Check::Turn))?;
+    link.stop().await.map_err(Failure::driver(Check::Turn))?;
     link.turn(Turn::by_deci_degrees(plan.turn_deci_degrees))
         .await
-        .map_err(fail(Check::Turn))?;
+        .map_err(Failure::driver(Check::Turn))?;
     log!(info, "[turn] {} (0.1°) sent once", plan.turn_deci_degrees);
     let start = link.now_ms();
     let gyro_peak = until_turned(link, plan, start, failsafe_before).await?;
@@ -276,7 +278,7 @@ async fn until_turned<L: Link>(
         }
         let now = link.now_ms();
         if let Some(Event::Telemetry(Downlink::Imu(imu))) =
-            link.poll().await.map_err(fail(Check::Turn))?
+            link.poll().await.map_err(Failure::driver(Check::Turn))?
         {
             gyro_peak = gyro_peak.max(imu.gyro[2].unsigned_abs());
         }
@@ -289,7 +291,7 @@ async fn until_turned<L: Link>(
                 Err(e @ chassis_protocol::driver::Error::Core(_)) => {
                     log!(warn, "[turn] pending angle unread: {}", e);
                 }
-                Err(e) => return Err(fail(Check::Turn)(e)),
+                Err(e) => return Err(Failure::driver(Check::Turn)(e)),
             }
             if pending.unsigned_abs() <= 10 {
                 return Ok(gyro_peak);
@@ -310,12 +312,12 @@ pub(super) async fn stop<L: Link>(
     drive: DriveType,
 ) -> Result<(), Failure> {
     if drive == DriveType::DifferentialOpenLoop {
-        link.stop().await.map_err(fail(Check::Stop))?;
+        link.stop().await.map_err(Failure::driver(Check::Stop))?;
         link.note(Note::Skipped(Check::Stop, Skip::NoEncoders));
         return Ok(());
     }
     link.note(Note::Start(Check::Stop));
-    link.stop().await.map_err(fail(Check::Stop))?;
+    link.stop().await.map_err(Failure::driver(Check::Stop))?;
     let still = Velocity::new(0, 0, 0);
     let _ = drive_for(link, plan, still, 100, Check::Stop).await?;
     let seen = drive_for(link, plan, still, 200, Check::Stop).await?;
@@ -356,7 +358,7 @@ pub(super) async fn battery<L: Link>(
     if battery.centivolts <= limit {
         let start = link.now_ms();
         while link.now_ms().saturating_sub(start) < 1_500 {
-            link.poll().await.map_err(fail(Check::Battery))?;
+            link.poll().await.map_err(Failure::driver(Check::Battery))?;
             if let Some(next) = link.core().battery() {
                 if next.at_ms > first.at_ms {
                     battery = next.value;
@@ -403,23 +405,25 @@ pub(super) async fn control_loop<L: Link>(
         let now = link.now_ms();
         if now >= next_send {
             next_send = now.saturating_add(plan.timing.command_period_ms);
-            link.set_velocity(cruise).await.map_err(fail(check))?;
+            link.set_velocity(cruise)
+                .await
+                .map_err(Failure::driver(check))?;
         }
         if now >= next_read {
             next_read = now.saturating_add(plan.loop_read_every_ms);
             let _ = link
                 .read_verified(Register::MotorVoltage)
                 .await
-                .map_err(fail(check))?;
+                .map_err(Failure::driver(check))?;
             reads = reads.saturating_add(1);
         }
-        link.poll().await.map_err(fail(check))?;
+        link.poll().await.map_err(Failure::driver(check))?;
         // The driver stopped a board that went quiet: never command motion past that.
         if link.core().failsafe_stops() != failsafe_before {
             return Err(failure(check, Why::FailsafeStop));
         }
     }
-    link.stop().await.map_err(fail(check))?;
+    link.stop().await.map_err(Failure::driver(check))?;
     report.loop_reads = reads;
     log!(
         info,

@@ -1,7 +1,6 @@
 //! A timed drive, as the 2020 checks judge it: the velocity re-sent every command period, the
 //! encoder frames taken in.
 
-use super::checks::fail;
 use super::{Failure, Link, Plan, Why};
 use crate::{Check, failure};
 use chassis_protocol::Downlink;
@@ -42,10 +41,12 @@ pub(super) async fn drive_for<L: Link>(
         let now = link.now_ms();
         if now >= next_send && velocity != still {
             next_send = now.saturating_add(plan.timing.command_period_ms);
-            link.set_velocity(velocity).await.map_err(fail(check))?;
+            link.set_velocity(velocity)
+                .await
+                .map_err(Failure::driver(check))?;
         }
         if let Some(Event::Telemetry(Downlink::Encoders(e))) =
-            link.poll().await.map_err(fail(check))?
+            link.poll().await.map_err(Failure::driver(check))?
         {
             first.get_or_insert(e.ticks);
             if let Some(previous) = last {

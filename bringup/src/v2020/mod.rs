@@ -120,6 +120,13 @@ pub enum Why {
     NoEncoderFrames,
 }
 
+/// A driver error: [`Why::Driver`].
+impl From<LinkError> for Why {
+    fn from(e: LinkError) -> Self {
+        Why::Driver(e)
+    }
+}
+
 /// A failed 2020 check and why.
 pub type Failure = crate::Failure<Why>;
 
