@@ -56,22 +56,31 @@ pub trait Common {
     }
 }
 
-/// A firmware generation's driver core, as the wrappers make it from a [`Config`]:
-/// [`DriverCore`] (2020) and `driver::v1::DriverCore` (v1.0.0). Sealed.
+/// A firmware generation's driver core, as the wrappers make it from a [`Config`] and as the
+/// bring-up reads it: [`DriverCore`] (2020) and `driver::v1::DriverCore` (v1.0.0). Sealed.
 pub trait Generation: Core + sealed::Sealed {
     /// A new core with `config` (what the driver's own constructor makes).
     fn with_config(config: Config) -> Self;
+    /// How many times the driver's failsafe has stopped the chassis (the core's own
+    /// `failsafe_stops`).
+    fn failsafe_stops(&self) -> u32;
 }
 
 impl Generation for DriverCore {
     fn with_config(config: Config) -> Self {
         DriverCore::new(config)
     }
+    fn failsafe_stops(&self) -> u32 {
+        DriverCore::failsafe_stops(self)
+    }
 }
 
 impl Generation for chassis_protocol::driver::v1::DriverCore {
     fn with_config(config: Config) -> Self {
         chassis_protocol::driver::v1::DriverCore::new(config)
+    }
+    fn failsafe_stops(&self) -> u32 {
+        chassis_protocol::driver::v1::DriverCore::failsafe_stops(self)
     }
 }
 

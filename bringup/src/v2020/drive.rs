@@ -1,7 +1,8 @@
 //! A timed drive, as the 2020 checks judge it: the velocity re-sent every command period, the
 //! encoder frames taken in.
 
-use super::{Failure, Link, Plan, Why};
+use super::checks::Run;
+use super::{Failure, Link, Why};
 use crate::{Check, failure};
 use chassis_protocol::Downlink;
 use chassis_protocol::Velocity;
@@ -21,12 +22,12 @@ pub(super) struct Seen {
 /// stopping the chassis ends it at once: never command motion past that.
 #[maybe_async::maybe_async]
 pub(super) async fn drive_for<L: Link>(
-    link: &mut L,
-    plan: &Plan,
+    run: &mut Run<'_, L>,
     velocity: Velocity,
     ms: u64,
     check: Check,
 ) -> Result<Seen, Failure> {
+    let (plan, link) = (run.plan, &mut *run.link);
     let still = Velocity::new(0, 0, 0);
     let start = link.now_ms();
     let mut next_send = start;
