@@ -32,12 +32,13 @@ pub(crate) trait Sequence<L: Common>: Sized {
     type Why: From<LinkError> + Logged;
     /// What the link check counts while it listens.
     type Counts: Default;
-    /// What the log names the generation by after "bring-up" and "passed": nothing on 2020.
+    /// What the log says after "bring-up" and "passed" to name the generation (nothing on
+    /// 2020, " (v1.0.0)" on v1.0.0).
     const NAMED: &'static str;
     /// What the log calls [`Common::stop`].
     const STOP: &'static str;
-    /// The checks that move, skipped without motion (but the control loop, skipped after the
-    /// battery).
+    /// The checks that move, in order, noted as skipped when the plan has no motion (the
+    /// control loop is not among them: it is skipped after the battery, where it would run).
     const MOVING: &'static [Check];
 
     /// The timing the plan holds.
