@@ -13,12 +13,15 @@
 //! | what a passed bring-up measured | [`v2020::Report`] | [`v1::Report`] |
 //! | a board's whole run | [`v2020::bring_up_and_park`] | [`v1::bring_up_and_park`] |
 //!
-//! Each module's documentation lists its sequence. A board that may meet either finds out first
-//! with `chassis_protocol::detect::detect` (the QEMU board does), then runs that generation's
-//! bring-up. Shared, here: the [`Check`]s (the same names and exit codes on both), [`Note`],
-//! [`Skip`], [`Failure`] (a check and the generation's reason), the [`Timing`] both plans hold,
-//! and the [`link`] wrappers. Nothing of either generation is re-exported at the root: a board
-//! running the 2020 bring-up names it, `chassis_bringup::v2020::{Plan, bring_up_and_park}`.
+//! Both run one sequence, written once: the checks in their order, each start and end noted,
+//! the checks that move skipped without motion, the stop after a failure, the verdict. Each
+//! module holds only what its checks do, and its documentation lists them in order. A board
+//! that may meet either generation finds out first with `chassis_protocol::detect::detect`
+//! (the QEMU board does), then runs that generation's bring-up. Shared, here: the [`Check`]s
+//! (the same names and exit codes on both), [`Note`], [`Skip`], [`Failure`] (a check and the
+//! generation's reason), the [`Timing`] both plans hold, and the [`link`] wrappers. Nothing of
+//! either generation is re-exported at the root: a board running the 2020 bring-up names it,
+//! `chassis_bringup::v2020::{Plan, bring_up_and_park}`.
 //!
 //! It is written as `async` code and compiled one of two ways: as is (feature `async`, for an
 //! executor such as embassy's), or as plain blocking code (feature `blocking`: the
@@ -55,6 +58,7 @@ macro_rules! log {
 }
 
 pub mod link;
+mod sequence;
 pub mod v1;
 pub mod v2020;
 
@@ -219,6 +223,13 @@ pub struct Failure<W> {
     pub check: Check,
     /// Why.
     pub why: W,
+}
+
+impl<W: From<LinkError>> Failure<W> {
+    /// `check` failed because the driver did (`Why::Driver`): what `map_err` takes.
+    fn driver(check: Check) -> impl Fn(LinkError) -> Self {
+        move |e| failure(check, W::from(e))
+    }
 }
 
 /// `check` failed, and why.

@@ -56,22 +56,31 @@ pub trait Common {
     }
 }
 
-/// A firmware generation's driver core, as the wrappers make it from a [`Config`]:
-/// [`DriverCore`] (2020) and `driver::v1::DriverCore` (v1.0.0). Sealed.
+/// A firmware generation's driver core, as the wrappers make it from a [`Config`] and as the
+/// bring-up reads it: [`DriverCore`] (2020) and `driver::v1::DriverCore` (v1.0.0). Sealed.
 pub trait Generation: Core + sealed::Sealed {
     /// A new core with `config` (what the driver's own constructor makes).
     fn with_config(config: Config) -> Self;
+    /// How many times the driver's failsafe has stopped the chassis (the core's own
+    /// `failsafe_stops`).
+    fn failsafe_stops(&self) -> u32;
 }
 
 impl Generation for DriverCore {
     fn with_config(config: Config) -> Self {
         DriverCore::new(config)
     }
+    fn failsafe_stops(&self) -> u32 {
+        DriverCore::failsafe_stops(self)
+    }
 }
 
 impl Generation for chassis_protocol::driver::v1::DriverCore {
     fn with_config(config: Config) -> Self {
         chassis_protocol::driver::v1::DriverCore::new(config)
+    }
+    fn failsafe_stops(&self) -> u32 {
+        chassis_protocol::driver::v1::DriverCore::failsafe_stops(self)
     }
 }
 
@@ -131,30 +140,6 @@ impl<U, C, K> Blocking<U, C, K> {
     }
 }
 
-#[cfg(feature = "blocking")]
-#[maybe_async::sync_impl]
-impl<U, C, K> Common for Blocking<U, C, K>
-where
-    U: embedded_io::Read + embedded_io::Write + embedded_io::ReadReady,
-    C: Clock + Clone,
-    K: Core,
-{
-    type Core = K;
-    type Event = K::Event;
-    fn now_ms(&mut self) -> u64 {
-        self.clock.now_ms()
-    }
-    fn core(&self) -> &K {
-        self.driver.core()
-    }
-    fn poll(&mut self) -> Result<Option<K::Event>, LinkError> {
-        self.driver.poll().map_err(kind)
-    }
-    fn stop(&mut self) -> Result<(), LinkError> {
-        self.driver.stop().map_err(kind)
-    }
-}
-
 /// The async driver under a bring-up (feature `async`). `K` is the driver's core: each
 /// generation names this wrapper over its own ([`v2020::Async`](crate::v2020::Async),
 /// [`v1::Async`](crate::v1::Async)).
@@ -191,15 +176,41 @@ impl<U, C, D, K> Async<U, C, D, K> {
     }
 }
 
-#[cfg(feature = "async")]
-#[maybe_async::async_impl(AFIT)]
-impl<U, C, D, K> Common for Async<U, C, D, K>
-where
-    U: embedded_io_async::Read + embedded_io_async::Write,
-    C: Clock + Clone,
-    D: embedded_hal_async::delay::DelayNs,
-    K: Core,
-{
+/// Implements a trait on each shell the build has, over the driver core `$core`, from one
+/// text: on `Blocking` (feature `blocking`), where `maybe-async` makes the text blocking (no
+/// `async`, no `.await`), and on `Async` (feature `async`), as written. `<K: Bound>` first
+/// makes the core a parameter. The implementations reach the driver as `self.driver` and its
+/// errors through `kind`.
+macro_rules! impl_on_shells {
+    ($(<$k:ident: $bound:path>)? $tr:path, core $core:ty, { $($body:tt)* }) => {
+        #[cfg(feature = "blocking")]
+        #[maybe_async::maybe_async(AFIT)]
+        impl<U, C $(, $k)?> $tr for $crate::link::Blocking<U, C, $core>
+        where
+            U: embedded_io::Read + embedded_io::Write + embedded_io::ReadReady,
+            C: chassis_protocol::driver::Clock + Clone,
+            $($k: $bound,)?
+        {
+            $($body)*
+        }
+
+        #[cfg(feature = "async")]
+        #[maybe_async::maybe_async(AFIT)]
+        impl<U, C, D $(, $k)?> $tr for $crate::link::Async<U, C, D, $core>
+        where
+            U: embedded_io_async::Read + embedded_io_async::Write,
+            C: chassis_protocol::driver::Clock + Clone,
+            D: embedded_hal_async::delay::DelayNs,
+            $($k: $bound,)?
+        {
+            $($body)*
+        }
+    };
+}
+#[cfg(any(feature = "blocking", feature = "async"))]
+pub(crate) use impl_on_shells;
+
+impl_on_shells!(<K: Core> Common, core K, {
     type Core = K;
     type Event = K::Event;
     fn now_ms(&mut self) -> u64 {
@@ -214,7 +225,7 @@ where
     async fn stop(&mut self) -> Result<(), LinkError> {
         self.driver.stop().await.map_err(kind)
     }
-}
+});
 
 /// Takes telemetry in for `ms`, every event to `take`; how long that took, ms.
 #[maybe_async::maybe_async]

@@ -1,9 +1,9 @@
 //! A timed drive, as the v1.0.0 checks judge it: the velocity re-sent every command period,
 //! the telemetry frames taken in.
 
-use super::checks::fail;
+use super::checks::Run;
 use super::yaw::{wrap_mrad, yaw_mrad};
-use super::{Failure, Link, Plan, Why};
+use super::{Failure, Link, Why};
 use crate::{Check, failure};
 use chassis_protocol::driver::v1::Event;
 use chassis_protocol::v1::{BodyVelocity, Telemetry};
@@ -55,18 +55,17 @@ impl Seen {
 
 /// Drives at `velocity` (if any: `None` watches after the forced stop) for `ms`, re-sending it
 /// every command period, taking telemetry in; frames that come `judge_after_ms` or more after
-/// the start are judged. The driver's failsafe stopping the chassis ends it at once: never
-/// command motion past that.
+/// the start are judged. The driver's failsafe stopping the chassis (since the settings were
+/// read) ends it at once: never command motion past that.
 #[maybe_async::maybe_async]
 pub(super) async fn drive_for<L: Link>(
-    link: &mut L,
-    plan: &Plan,
+    run: &mut Run<'_, L>,
     velocity: Option<BodyVelocity>,
     ms: u64,
     judge_after_ms: u64,
     check: Check,
-    failsafe_before: u32,
 ) -> Result<Seen, Failure> {
+    let (plan, link, failsafe_before) = (run.plan, &mut *run.link, run.failsafe_before);
     let start = link.now_ms();
     let mut next_send = start;
     let mut seen = Seen::default();
@@ -81,10 +80,12 @@ pub(super) async fn drive_for<L: Link>(
         if let Some(velocity) = velocity {
             if now >= next_send {
                 next_send = now.saturating_add(plan.timing.command_period_ms);
-                link.set_velocity(velocity).await.map_err(fail(check))?;
+                link.set_velocity(velocity)
+                    .await
+                    .map_err(Failure::driver(check))?;
             }
         }
-        if let Some(Event::Telemetry(t)) = link.poll().await.map_err(fail(check))? {
+        if let Some(Event::Telemetry(t)) = link.poll().await.map_err(Failure::driver(check))? {
             if now.saturating_sub(start) >= judge_after_ms {
                 seen.take(&t, now);
             }

@@ -3,7 +3,8 @@
 //! (`Blocking`, `Async`, each made with `new`). Its twin for the 2020 firmware is
 //! [`crate::v2020`], the same parts under the same names.
 //!
-//! The sequence, each step a named [`Check`] (one function each in `checks.rs`):
+//! The sequence, each step a named [`Check`] (run in this order by the one sequence both
+//! generations share; what each does here is in `checks.rs`):
 //!
 //! 1. [`Check::Link`]: telemetry frames (one 32-byte frame, 20–24 Hz) are counted over
 //!    [`Timing::listen_ms`]: at least 70 % of 20 Hz.
@@ -40,8 +41,10 @@ mod drive;
 mod link;
 mod yaw;
 
+#[cfg(doc)]
+use crate::Check;
 use crate::link::Common;
-use crate::{Check, LinkError, Note, Skip, Timing};
+use crate::{LinkError, Timing};
 use chassis_protocol::driver::v1::{DriverCore, Event};
 use chassis_protocol::v1::{BodyVelocity, Geometry, Pid, Readback, Reply, SystemSettings};
 
@@ -123,6 +126,13 @@ pub enum Why {
     FailsafeStop,
 }
 
+/// A driver error: [`Why::Driver`].
+impl From<LinkError> for Why {
+    fn from(e: LinkError) -> Self {
+        Why::Driver(e)
+    }
+}
+
 /// A failed v1.0.0 check and why.
 pub type Failure = crate::Failure<Why>;
 
@@ -171,64 +181,7 @@ pub trait Link: Common<Core = DriverCore, Event = Event> {
     async fn readback(&mut self, readback: Readback) -> Result<Reply, LinkError>;
 }
 
-/// Runs the whole v1.0.0 bring-up on `link`. On a failure the chassis gets the forced stop
-/// (best effort, if the plan moves it) and the failed check is returned.
-#[maybe_async::maybe_async]
-pub async fn bring_up<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
-    let result = steps(link, plan).await;
-    if let Err(failure) = &result {
-        log!(
-            error,
-            "bring-up (v1.0.0): {} failed: {}",
-            failure.check,
-            failure.why
-        );
-        if plan.timing.motion {
-            if let Err(e) = link.stop().await {
-                log!(error, "forced stop after the failure: {}", e);
-            }
-        }
-    }
-    result
-}
-
-/// What a board on real hardware does: runs the bring-up, logs its verdict, then keeps reading
-/// telemetry for ever (the chassis stopped, so the failsafe has nothing to do).
-#[maybe_async::maybe_async]
-pub async fn bring_up_and_park<L: Link>(link: &mut L, plan: &Plan) -> ! {
-    match bring_up(link, plan).await {
-        Ok(report) => log!(info, "PASS: every check passed (v1.0.0): {}", report),
-        Err(failure) => log!(error, "FAIL: {} ({})", failure.check, failure.why),
-    }
-    crate::link::park(link).await
-}
-
-/// The checks in their order; without motion, those that move are skipped.
-#[maybe_async::maybe_async]
-async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
-    let mut report = Report::default();
-    checks::link(link, plan, &mut report).await?;
-    checks::settings(link, &mut report).await?;
-    let failsafe_before = link.core().failsafe_stops();
-    if plan.timing.motion {
-        checks::straight(link, plan, &mut report, failsafe_before).await?;
-        checks::turn(link, plan, &mut report, failsafe_before).await?;
-        checks::stop(link, plan, &mut report, failsafe_before).await?;
-    } else {
-        for check in [Check::Forward, Check::Strafe, Check::Turn, Check::Stop] {
-            link.note(Note::Skipped(check, Skip::NoMotion));
-        }
-    }
-    checks::battery(link, plan, &mut report).await?;
-    if plan.timing.motion {
-        checks::control_loop(link, plan, &mut report, failsafe_before).await?;
-    } else {
-        link.note(Note::Skipped(Check::ControlLoop, Skip::NoMotion));
-    }
-    let stats = link.core().parser_stats();
-    report.bad_frames = stats
-        .bad_checksum
-        .saturating_add(stats.bad_end)
-        .saturating_add(stats.refused);
-    Ok(report)
-}
+crate::sequence::entry_points!(
+    /// Runs the whole v1.0.0 bring-up on `link`. On a failure the chassis gets the forced stop
+    /// (best effort, if the plan moves it) and the failed check is returned.
+);

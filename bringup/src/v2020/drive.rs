@@ -1,8 +1,8 @@
 //! A timed drive, as the 2020 checks judge it: the velocity re-sent every command period, the
 //! encoder frames taken in.
 
-use super::checks::fail;
-use super::{Failure, Link, Plan, Why};
+use super::checks::Run;
+use super::{Failure, Link, Why};
 use crate::{Check, failure};
 use chassis_protocol::Downlink;
 use chassis_protocol::Velocity;
@@ -22,12 +22,12 @@ pub(super) struct Seen {
 /// stopping the chassis ends it at once: never command motion past that.
 #[maybe_async::maybe_async]
 pub(super) async fn drive_for<L: Link>(
-    link: &mut L,
-    plan: &Plan,
+    run: &mut Run<'_, L>,
     velocity: Velocity,
     ms: u64,
     check: Check,
 ) -> Result<Seen, Failure> {
+    let (plan, link) = (run.plan, &mut *run.link);
     let still = Velocity::new(0, 0, 0);
     let start = link.now_ms();
     let mut next_send = start;
@@ -42,10 +42,12 @@ pub(super) async fn drive_for<L: Link>(
         let now = link.now_ms();
         if now >= next_send && velocity != still {
             next_send = now.saturating_add(plan.timing.command_period_ms);
-            link.set_velocity(velocity).await.map_err(fail(check))?;
+            link.set_velocity(velocity)
+                .await
+                .map_err(Failure::driver(check))?;
         }
         if let Some(Event::Telemetry(Downlink::Encoders(e))) =
-            link.poll().await.map_err(fail(check))?
+            link.poll().await.map_err(Failure::driver(check))?
         {
             first.get_or_insert(e.ticks);
             if let Some(previous) = last {

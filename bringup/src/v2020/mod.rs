@@ -2,7 +2,8 @@
 //! [`Link`], the 2020 driver (`Blocking`, `Async`, each made with `new`). Its twin for
 //! v1.0.0 is [`crate::v1`], the same parts under the same names.
 //!
-//! The sequence, each step a named [`Check`] (one function each in `checks.rs`):
+//! The sequence, each step a named [`Check`] (run in this order by the one sequence both
+//! generations share; what each does here is in `checks.rs`):
 //!
 //! 1. [`Check::Link`]: telemetry arrives; each stream's rate is measured over
 //!    [`Timing::listen_ms`] and must be near its nominal one (IMU 100 Hz, encoders 25 Hz,
@@ -37,8 +38,10 @@ mod link;
 
 pub use checks::{SNAPSHOT_POSTCARD_MAX, encode_snapshot};
 
+#[cfg(doc)]
+use crate::Check;
 use crate::link::Common;
-use crate::{Check, LinkError, Note, Skip, Timing};
+use crate::{LinkError, Timing};
 use chassis_protocol::driver::{DriverCore, Event};
 use chassis_protocol::registers::Snapshot;
 use chassis_protocol::{DriveType, Register, Stream, Turn, Velocity, Write};
@@ -120,6 +123,13 @@ pub enum Why {
     NoEncoderFrames,
 }
 
+/// A driver error: [`Why::Driver`].
+impl From<LinkError> for Why {
+    fn from(e: LinkError) -> Self {
+        Why::Driver(e)
+    }
+}
+
 /// A failed 2020 check and why.
 pub type Failure = crate::Failure<Why>;
 
@@ -168,67 +178,7 @@ pub trait Link: Common<Core = DriverCore, Event = Event> {
     async fn write(&mut self, write: Write) -> Result<(), LinkError>;
 }
 
-/// Runs the whole 2020 bring-up on `link`. On a failure the chassis is stopped (best effort)
-/// and the failed check returned.
-#[maybe_async::maybe_async]
-pub async fn bring_up<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
-    let result = steps(link, plan).await;
-    if let Err(failure) = &result {
-        log!(error, "bring-up: {} failed: {}", failure.check, failure.why);
-        // Without motion nothing was set moving: nothing but reads is sent.
-        if plan.timing.motion {
-            if let Err(e) = link.stop().await {
-                log!(error, "stop after the failure: {}", e);
-            }
-        }
-    }
-    result
-}
-
-/// What a board on real hardware does: runs the bring-up, logs its verdict, then keeps reading
-/// telemetry for ever (the chassis stopped, so the failsafe has nothing to do).
-#[maybe_async::maybe_async]
-pub async fn bring_up_and_park<L: Link>(link: &mut L, plan: &Plan) -> ! {
-    match bring_up(link, plan).await {
-        Ok(report) => log!(info, "PASS: every check passed: {}", report),
-        Err(failure) => log!(error, "FAIL: {} ({})", failure.check, failure.why),
-    }
-    crate::link::park(link).await
-}
-
-/// The checks in their order; without motion, those that move are skipped.
-#[maybe_async::maybe_async]
-async fn steps<L: Link>(link: &mut L, plan: &Plan) -> Result<Report, Failure> {
-    let mut report = Report::default();
-    checks::link(link, plan, &mut report).await?;
-    let snapshot = checks::settings(link, &mut report).await?;
-    let failsafe_before = link.core().failsafe_stops();
-    if plan.timing.motion {
-        checks::cancel_pending_turn(link, report.pending_before).await?;
-        let drive = checks::drive_type(link, plan, &snapshot).await?;
-        checks::straight(link, plan, drive, &mut report, failsafe_before).await?;
-        checks::turn(link, plan, &mut report, failsafe_before).await?;
-        checks::stop(link, plan, drive).await?;
-    } else {
-        for check in [
-            Check::DriveType,
-            Check::Forward,
-            Check::Strafe,
-            Check::Turn,
-            Check::Stop,
-        ] {
-            link.note(Note::Skipped(check, Skip::NoMotion));
-        }
-    }
-    checks::battery(link, plan, &snapshot, &mut report).await?;
-    if plan.timing.motion {
-        checks::control_loop(link, plan, &mut report, failsafe_before).await?;
-    } else {
-        link.note(Note::Skipped(Check::ControlLoop, Skip::NoMotion));
-    }
-    report.missed = Stream::ALL
-        .into_iter()
-        .map(|s| link.core().stream(s).missed)
-        .fold(0u32, u32::saturating_add);
-    Ok(report)
-}
+crate::sequence::entry_points!(
+    /// Runs the whole 2020 bring-up on `link`. On a failure the chassis is stopped (best
+    /// effort) and the failed check returned.
+);
