@@ -208,6 +208,10 @@ pub(crate) fn tick<R: Rules>(core: &mut R, now_ms: u64) -> Option<R::Event> {
                 // Judged now, but heard when its last byte came: the failsafe counts silence
                 // from there.
                 event = hear(core, frame, last);
+            } else {
+                // Nothing came out of the bytes before the quiet: if they came after a read,
+                // they were its answer, damaged.
+                pump.safety.quiet_after_garbage(last);
             }
         }
     }

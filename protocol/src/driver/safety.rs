@@ -9,7 +9,8 @@
 //!   sees the start of one frame completed by another.
 //! * **The failsafe.** While the chassis is moving, no frame heard from the board for
 //!   `failsafe_ms` (or `settings_pause_ms` after a settings frame, until telemetry is back; a
-//!   read counts once the board has answered it, and a read unanswered ends the allowance)
+//!   read counts once the board has answered it, whole or damaged, and a read unanswered ends
+//!   the allowance)
 //!   queues the wire format's stop
 //!   frame ([`Wire::stop`]), ahead of anything else not yet begun.
 //! * **Time** is the core's own monotonic milliseconds ([`Timebase`]): a `u32` tick counter that
@@ -67,6 +68,8 @@ pub(crate) struct Safety<W: Wire> {
     /// When the last read went: the low 32 bits of the core's time (its reply comes well
     /// within 2^32 ms).
     read_sent_low: u32,
+    /// What the board has answered to the last read.
+    answer: Answer,
     /// Telemetry frames heard since the last settings frame (saturating at 255).
     telemetry_after_settings: u8,
     moving_since_ms: Option<u64>,
@@ -74,6 +77,19 @@ pub(crate) struct Safety<W: Wire> {
     /// Pump turns in a row, while a request runs, that saw the clock stand still.
     stalled: u32,
     stalled_at: Option<u64>,
+}
+
+/// What the board has answered to the last read, as far as the failsafe is concerned.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+enum Answer {
+    /// No read waits (none sent, or its reply heard, or given up on).
+    Settled,
+    /// The read went; nothing from the board since says it took it.
+    Awaited,
+    /// After the read went, bytes came that made no frame, then the line went quiet: the board
+    /// answered, and the answer was damaged on the line. It took the read, so it may pause.
+    Damaged,
 }
 
 /// The failsafe's limits, from [`Config`].
@@ -116,6 +132,7 @@ impl<W: Wire> Safety<W> {
             },
             settings_sent_ms: None,
             read_sent_low: 0,
+            answer: Answer::Settled,
             telemetry_after_settings: 0,
             moving_since_ms: None,
             failsafe_stops: 0,
@@ -178,12 +195,15 @@ impl<W: Wire> Safety<W> {
     pub(crate) fn load(&mut self, frame: W::Frame, kind: FrameKind) {
         // The board pauses its telemetry while settings are made, reads included (A13). A
         // write or an action is answered by nothing: its pause is allowed from when it goes. A
-        // read's is allowed from when it went, once its reply comes (`reply_heard`): a board
-        // that answers no read is silent, not paused, and reads sent to it never hold the
-        // failsafe off.
+        // read's is allowed from when it went, once its reply comes (`reply_heard`), whole or
+        // damaged (`quiet_after_garbage`): a board that answers no read is silent, not paused,
+        // and reads sent to it never hold the failsafe off.
         match kind {
             FrameKind::Settings => self.settings_sent(self.now()),
-            FrameKind::Read => self.read_sent_low = self.now() as u32,
+            FrameKind::Read => {
+                self.read_sent_low = self.now() as u32;
+                self.answer = Answer::Awaited;
+            }
             FrameKind::Motion => {}
         }
         self.tx = Some(InFlight {
@@ -274,20 +294,48 @@ impl<W: Wire> Safety<W> {
     /// (and paused), so it says nothing about the pause being over.
     pub(crate) fn reply_heard(&mut self, at_ms: u64) {
         self.heard(at_ms);
-        // The board answered: it took the last read, and may pause its telemetry from then.
-        let since_read = u64::from((at_ms as u32).wrapping_sub(self.read_sent_low));
-        let read = at_ms.saturating_sub(since_read);
+        self.answer = Answer::Settled;
+        self.read_taken(at_ms);
+    }
+
+    /// The board took the last read (its answer came at `at_ms`): it may pause its telemetry
+    /// from when the read went.
+    fn read_taken(&mut self, at_ms: u64) {
+        let read = self.read_sent_ms(at_ms);
         let since = self.settings_sent_ms.map_or(read, |t| t.max(read));
         self.settings_sent(since);
     }
 
+    /// When the last read went, seen from `at_ms` (at or after it).
+    fn read_sent_ms(&self, at_ms: u64) -> u64 {
+        let since_read = u64::from((at_ms as u32).wrapping_sub(self.read_sent_low));
+        at_ms.saturating_sub(since_read)
+    }
+
+    /// The line went quiet after bytes that made no frame, the last of them at `last_byte_ms`
+    /// (the parser threw them away). If they came after the awaited read went, the board
+    /// answered it and the answer was damaged on the line (a byte lost, changed or added): the
+    /// board took the read and may pause, as for a reply heard whole. The read itself still
+    /// waits for a reply it can use; only the failsafe counts this as an answer.
+    pub(crate) fn quiet_after_garbage(&mut self, last_byte_ms: u64) {
+        let after_read = last_byte_ms > self.read_sent_ms(last_byte_ms);
+        let no_frame_since = self.heard.any_ms.is_none_or(|t| t < last_byte_ms);
+        if self.answer == Answer::Awaited && after_read && no_frame_since {
+            self.answer = Answer::Damaged;
+            self.read_taken(last_byte_ms);
+        }
+    }
+
     /// The last read went unanswered past its deadline: the board is not answering, so it is
-    /// not paused either (a paused board answers reads). The pause allowed for the frames sent
-    /// up to that read ends: silence counts from the last frame heard.
+    /// not paused either (a paused board answers reads), unless it answered it damaged. The
+    /// pause allowed for the frames sent up to that read ends: silence counts from the last
+    /// frame heard.
     pub(crate) fn read_unanswered(&mut self) {
-        let now = self.now();
-        let since_read = u64::from((now as u32).wrapping_sub(self.read_sent_low));
-        let read = now.saturating_sub(since_read);
+        let answer = core::mem::replace(&mut self.answer, Answer::Settled);
+        if answer == Answer::Damaged {
+            return;
+        }
+        let read = self.read_sent_ms(self.now());
         if self.settings_sent_ms.is_some_and(|t| t <= read) {
             self.settings_sent_ms = None;
         }

@@ -30,9 +30,12 @@
 //! the board (telemetry or reply) for [`Config::failsafe_ms`] (100 ms), except that after a
 //! settings frame the board may stay silent for [`Config::settings_pause_ms`] (600 ms), since it
 //! pauses telemetry while settings are made (A13: up to at least 500 ms), until its telemetry
-//! comes back (the pause is then over: from there on, 100 ms of silence is a dead link). For a
-//! read, "comes back" counts only telemetry after the reply: the board answers when it takes the
-//! read, so frames heard before the reply were on their way before the pause began.
+//! comes back (the pause is then over: from there on, 100 ms of silence is a dead link). A read
+//! counts once the board has answered it, even if the answer was damaged on the line (bytes
+//! after the read that make no frame, then a quiet line): a board that answers no read is
+//! silent, not paused. For a read, "comes back" counts only telemetry after the reply: the
+//! board answers when it takes the read, so frames heard before the reply were on their way
+//! before the pause began.
 //!
 //! It is judged on the input already read: a shell calls [`DriverCore::tick`] only after taking
 //! in every byte the UART holds, so a slow loop never mistakes its own slowness for a dead link.

@@ -391,6 +391,85 @@ fn a_read_unanswered_ends_the_pause_an_answered_read_allowed() {
     assert_stopped_in_time(stopped, heard);
 }
 
+/// The motor-voltage read's reply (`#`, code `0B`, 1200 as `00 00 04 B0`) with a byte added on
+/// the line after the `#`: no frame comes of it.
+const DAMAGED_REPLY: [u8; 7] = [0x23, 0xE3, 0x0B, 0x00, 0x00, 0x04, 0xB0];
+
+/// Ticks the core a millisecond at a time from `from` to `to`, sending whatever it has (its
+/// retries); when the failsafe's stop went, if it did.
+fn stop_between(core: &mut DriverCore, from: u64, to: u64) -> Option<u64> {
+    for now in from..=to {
+        let _ = core.tick(now);
+        while let Some(frame) = out(core, now) {
+            if frame == STOP {
+                return Some(now);
+            }
+        }
+    }
+    None
+}
+
+/// Moving at 0 with telemetry streaming (IMU at 0..=50), then the motor-voltage read at 50.
+fn moving_with_a_read() -> DriverCore {
+    let mut core = DriverCore::new(Config::DEFAULT);
+    for seq in 0..=5 {
+        imu(&mut core, seq, u64::from(seq) * 10);
+    }
+    drive(&mut core, 0);
+    core.start(Request::Read(Register::MotorVoltage)).unwrap();
+    assert!(out(&mut core, 50).is_some());
+    core
+}
+
+#[test]
+fn a_reply_damaged_on_the_line_still_allows_the_boards_pause() {
+    // Found by the emulator's noisy bring-up: a byte added to a read's reply while moving,
+    // the board's telemetry pause after it (it took the read), and the failsafe stopped the
+    // chassis 100 ms after the last frame heard. Bytes that make no frame after a read, then a
+    // quiet line, are the board's answer, damaged: it took the read and may pause.
+    let mut core = moving_with_a_read();
+    let mut rest = &DAMAGED_REPLY[..];
+    while !rest.is_empty() {
+        rest = core.receive(rest, 53).1;
+    }
+    // The board pauses 200 ms: no stop (the read retried meanwhile goes unanswered too).
+    assert_eq!(stop_between(&mut core, 53, 253), None);
+    assert_eq!(core.failsafe_stops(), 0);
+    // Its telemetry back, the pause is over: silence from the last frame stops it in time.
+    imu(&mut core, 6, 260);
+    imu(&mut core, 7, 270);
+    assert_stopped_in_time(stop_between(&mut core, 271, 1_000), 270);
+}
+
+#[test]
+fn a_damaged_answer_holds_the_failsafe_off_no_longer_than_the_settings_pause() {
+    // The board answers damaged, then never again: stopped at most settings_pause_ms after
+    // the read went, as after any settings frame.
+    let mut core = moving_with_a_read();
+    let _ = core.receive(&DAMAGED_REPLY, 53);
+    let stopped = stop_between(&mut core, 53, 2_000).expect("the failsafe stops it");
+    assert!(
+        (150..=50 + u64::from(Config::DEFAULT.settings_pause_ms) + 2).contains(&stopped),
+        "stopped at {stopped}"
+    );
+}
+
+#[test]
+fn bytes_before_a_read_are_no_answer_to_it() {
+    // The same bytes, heard before the read went: nothing took the read, the board is just
+    // silent from 50, and the stop comes failsafe_ms after the last frame heard.
+    let mut core = DriverCore::new(Config::DEFAULT);
+    for seq in 0..=5 {
+        imu(&mut core, seq, u64::from(seq) * 10);
+    }
+    drive(&mut core, 0);
+    let _ = core.receive(&DAMAGED_REPLY, 50);
+    let _ = core.tick(55);
+    core.start(Request::Read(Register::MotorVoltage)).unwrap();
+    assert!(out(&mut core, 55).is_some());
+    assert_stopped_in_time(stop_between(&mut core, 55, 1_000), 50);
+}
+
 #[test]
 fn stop_cancels_an_outstanding_turn() {
     let mut core = idle_core();
