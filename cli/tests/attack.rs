@@ -359,10 +359,14 @@ fn run(index: usize, ending: Ending, moment_ms: u64, dir: &std::path::Path) -> O
     // (A monitor refusing a standard input that is not a terminal ends at once: that is its
     // answer, judged as such below.)
     let refused = case.needs_terminal && ending == Ending::InputEnded;
-    let mut ended_first =
-        !refused && (started.child().try_wait().unwrap().is_some() || so_far.contains("FAIL"));
+    // (A process already ended has been reaped by `try_wait`: it is not signalled, its pid may
+    // be another's by now. One that ends after it was looked at is a zombie until reaped, and
+    // takes the signal harmlessly.)
+    let already_ended = started.child().try_wait().unwrap().is_some();
+    let mut ended_first = !refused && (already_ended || so_far.contains("FAIL"));
     let mut said = String::new();
     match (&mut started, ending) {
+        (_, Ending::Signal(..)) if already_ended => {}
         (started, Ending::Signal(name, _)) => harness::signal(started.child(), name),
         (Started::Terminal(term), Ending::TerminalClosed) => {
             said = term.written();
