@@ -597,8 +597,25 @@ fn runs(outcomes: &[Outcome]) -> String {
     text
 }
 
+/// Whether this process ignores SIGHUP (started under `nohup`): its commands inherit that, and
+/// rightly keep ignoring it, so the SIGHUP endings cannot be tried from here.
+fn sighup_ignored() -> bool {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("SigIgn:"))
+        .and_then(|mask| u64::from_str_radix(mask.trim(), 16).ok())
+        .is_some_and(|mask| mask & 1 != 0)
+}
+
 #[test]
 fn every_ending_of_every_command_stops_the_chassis() {
+    assert!(
+        !sighup_ignored(),
+        "SIGHUP is ignored in this test process (started under nohup?): every command inherits \
+         that and keeps ignoring it, as it should, so the SIGHUP endings cannot be tried; run \
+         the suite without nohup (setsid detaches it from the terminal instead)"
+    );
     let dir = std::env::temp_dir().join(format!("chassis-attack-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let mut jobs = Vec::new();
