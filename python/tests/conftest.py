@@ -4,12 +4,20 @@ hand from the spec's tables."""
 
 from __future__ import annotations
 
+import signal
 import time
 from typing import Callable, Iterator
 
 import pytest
 
 import chassis
+
+# A test run started in the background of a non-interactive shell (`cmd &` in a CI script)
+# inherits SIGINT ignored, and so would every program the tests start: Python then never raises
+# KeyboardInterrupt in them, and the tests of what Ctrl-C does could not be run. A handler here
+# (not "ignore") is reset to the default in each program started, as a terminal would give it.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 # 2020 firmware, table 1A: velocity mode, X = Y = Z = 0, no direction bits.
 STOP = bytes.fromhex("FF FE 01 00 00 00 00 00 00 00")
