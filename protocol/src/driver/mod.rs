@@ -58,8 +58,10 @@
 //! (telemetry or reply) has been read for [`Config::failsafe_ms`] (100 ms; 200 ms with
 //! [`Config::HOST`]), or, after a settings frame, for [`Config::settings_pause_ms`] (600 ms:
 //! the board pauses telemetry while settings are made, A13) until its telemetry is back; a read
-//! counts as a settings frame once the board has answered it (whole, or damaged on the line:
-//! bytes after the read that make no frame, then a quiet line), and a read left without any
+//! counts as a settings frame once the board has answered it (whole, or on the 2020 board
+//! damaged on the line: bytes after the read that make no frame, then a quiet line; so a 2020
+//! link dying in the middle of a frame while a read waits is stopped within the settings
+//! pause), and a read left without any
 //! answer ends the allowance (a paused board still answers reads: reads a silent board leaves
 //! unanswered never hold the failsafe off, however often they are sent). It is
 //! judged only after every byte the UART holds has been read, so a loop slower than the limit

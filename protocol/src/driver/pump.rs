@@ -93,6 +93,11 @@ pub(crate) trait Rules: Sized {
     fn quiet_ms(config: &Config) -> u64;
     /// Whether a frame from the board answers a request (else it is telemetry).
     fn is_reply(frame: &Heard<Self>) -> bool;
+    /// Whether bytes after a read that make no frame, then a quiet line, are taken as the
+    /// read's answer damaged on the line, for the failsafe's pause allowance: for a board that
+    /// pauses its telemetry after a read it took (the 2020 board, A13), not for one that does
+    /// not (there a frame cut short by a dying link must not hold the failsafe off).
+    const DAMAGED_REPLIES_PAUSE: bool;
 
     /// The request's next frame, if one is due at `now`.
     fn job_frame(&mut self, now: u64) -> Option<(<Self::Wire as Wire>::Frame, FrameKind)>;
@@ -208,7 +213,7 @@ pub(crate) fn tick<R: Rules>(core: &mut R, now_ms: u64) -> Option<R::Event> {
                 // Judged now, but heard when its last byte came: the failsafe counts silence
                 // from there.
                 event = hear(core, frame, last);
-            } else {
+            } else if R::DAMAGED_REPLIES_PAUSE {
                 // Nothing came out of the bytes before the quiet: if they came after a read,
                 // they were its answer, damaged.
                 pump.safety.quiet_after_garbage(last);

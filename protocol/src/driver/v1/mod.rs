@@ -340,6 +340,9 @@ impl Rules for DriverCore {
         matches!(frame, Downlink::Reply(_))
     }
 
+    // It pauses for settings frames only, not for readbacks.
+    const DAMAGED_REPLIES_PAUSE: bool = false;
+
     fn job_frame(&mut self, now: u64) -> Option<(Outgoing, FrameKind)> {
         self.next_job_frame(now)
     }

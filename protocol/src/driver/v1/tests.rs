@@ -5,6 +5,8 @@ use crate::v1::{Geometry, Pid, SystemSettings};
 
 /// The forced stop, from PROTOCOL-V1.md: `0x25`, ten `00`, BCC `7B ^ 25 = 5E`.
 const FORCED_STOP: [u8; 14] = [0x7B, 0x25, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x5E, 0x7D];
+/// The readback request of the geometry: `7B 34`, ten `00`, BCC `7B ^ 34 = 4F`, `7D`.
+const READ_GEOMETRY: [u8; 14] = [0x7B, 0x34, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x4F, 0x7D];
 /// The vendor's readback request of the system settings.
 const READ_SYSTEM: [u8; 14] = [0x7B, 0x33, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x48, 0x7D];
 
@@ -98,6 +100,28 @@ fn readbacks_a_silent_board_leaves_unanswered_never_hold_the_failsafe_off() {
         "the forced stop 300 ms after the board was last heard"
     );
     assert_eq!(core.failsafe_stops(), 1);
+}
+
+#[test]
+fn a_frame_cut_short_after_a_readback_never_holds_the_failsafe_off() {
+    // Heard whole at 10; a readback goes at 20; the link dies in the middle of the next
+    // telemetry frame (its first 12 bytes heard at 25). The v1.0.0 board pauses for no
+    // readback, so those bytes are no answer: the forced stop 300 ms after the last frame.
+    let mut core = driving(0);
+    hear(&mut core, &telemetry(), 10);
+    core.start(Request::Read(Readback::Geometry)).unwrap();
+    assert_eq!(out(&mut core, 20), vec![READ_GEOMETRY.to_vec()]);
+    hear(&mut core, &telemetry()[..12], 25);
+    let mut stopped = None;
+    let mut now = 25;
+    while now < 2_000 && stopped.is_none() {
+        now += 1;
+        core.tick(now);
+        if out(&mut core, now).contains(&FORCED_STOP.to_vec()) {
+            stopped = Some(now);
+        }
+    }
+    assert_eq!(stopped, Some(311), "the forced stop 300 ms after the last frame");
 }
 
 #[test]

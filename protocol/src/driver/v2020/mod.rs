@@ -467,6 +467,9 @@ impl Rules for DriverCore {
         matches!(frame, Downlink::Reply(_))
     }
 
+    // It pauses its telemetry after a read it took (A13).
+    const DAMAGED_REPLIES_PAUSE: bool = true;
+
     fn job_frame(&mut self, now: u64) -> Option<(Outgoing, FrameKind)> {
         self.next_job_frame(now)
     }
