@@ -121,7 +121,11 @@ fn a_frame_cut_short_after_a_readback_never_holds_the_failsafe_off() {
             stopped = Some(now);
         }
     }
-    assert_eq!(stopped, Some(311), "the forced stop 300 ms after the last frame");
+    assert_eq!(
+        stopped,
+        Some(311),
+        "the forced stop 300 ms after the last frame"
+    );
 }
 
 #[test]
