@@ -8,7 +8,7 @@
 //! cargo run -p chassis-ros2 --example cmd_vel -- --vx 0.2 --wz 0.5 --rate 20 --for 3
 //! ```
 
-use chassis_ros2::msg::{Message, Odometry, Twist};
+use chassis_ros2::msg::{Header, Message, Odometry, Time, Twist, TwistStamped};
 use clap::Parser;
 use ros2_client::qos::{Durability, History, WhenFull};
 use ros2_client::{
@@ -37,6 +37,16 @@ struct Args {
     /// Seconds to wait for the node before publishing.
     #[arg(long, default_value = "2")]
     wait: f64,
+    /// Publish geometry_msgs/TwistStamped, stamped now (for a node run with --stamped).
+    #[arg(long)]
+    stamped: bool,
+}
+
+/// The system clock, ns since the Unix epoch.
+fn now_ns() -> i64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| i64::try_from(d.as_nanos()).unwrap_or(i64::MAX))
 }
 
 fn main() -> Result<(), String> {
@@ -62,10 +72,18 @@ fn main() -> Result<(), String> {
         )
         .map_err(|e| format!("{e:?}"))
     };
-    let cmd_topic = topic(&mut node, "cmd_vel", Twist::PACKAGE, Twist::NAME)?;
+    let (package, ty) = if args.stamped {
+        (TwistStamped::PACKAGE, TwistStamped::NAME)
+    } else {
+        (Twist::PACKAGE, Twist::NAME)
+    };
+    let cmd_topic = topic(&mut node, "cmd_vel", package, ty)?;
     let odom_topic = topic(&mut node, "odom", Odometry::PACKAGE, Odometry::NAME)?;
-    let publisher = node
+    let plain = node
         .create_publisher::<Twist>(&cmd_topic, None)
+        .map_err(|e| format!("{e:?}"))?;
+    let stamped = node
+        .create_publisher::<TwistStamped>(&cmd_topic, None)
         .map_err(|e| format!("{e:?}"))?;
     let odom = node
         .create_subscription::<Odometry>(&odom_topic, None)
@@ -84,7 +102,16 @@ fn main() -> Result<(), String> {
     while Instant::now() < end + Duration::from_secs(1) {
         let now = Instant::now();
         if now >= next && now < end {
-            if publisher.publish(twist).is_ok() {
+            let published = if args.stamped {
+                let header = Header {
+                    stamp: Time::from_nanos(now_ns()),
+                    frame_id: "base_link".into(),
+                };
+                stamped.publish(TwistStamped { header, twist }).is_ok()
+            } else {
+                plain.publish(twist).is_ok()
+            };
+            if published {
                 sent += 1;
             }
             next += period;
