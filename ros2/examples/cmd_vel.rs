@@ -122,6 +122,12 @@ fn main() -> Result<(), String> {
         }
         std::thread::sleep(Duration::from_millis(1));
     }
-    println!("sent {sent} /cmd_vel; heard {heard} /odom; last position {last:?}");
+    match last {
+        Some(p) => println!(
+            "sent {sent} /cmd_vel; heard {heard} /odom; last position ({:.3}, {:.3}) m",
+            p.x, p.y
+        ),
+        None => println!("sent {sent} /cmd_vel; heard no /odom"),
+    }
     Ok(())
 }
