@@ -36,7 +36,7 @@ fn a_silent_cmd_vel_stops_the_chassis_after_the_timeout() {
         .collect();
     let first = moving.first().expect("the chassis was driven");
     assert!(
-        ms_between(first_given, first.0) < 30.0,
+        ms_between(first_given, first.0) < 50.0,
         "the first command went out at once: {} ms",
         ms_between(first_given, first.0)
     );
@@ -46,16 +46,24 @@ fn a_silent_cmd_vel_stops_the_chassis_after_the_timeout() {
         .expect("a stop after the last command");
     let silence = ms_between(last_given, stop.0);
     assert!(
-        (500.0..=580.0).contains(&silence),
+        (500.0..=600.0).contains(&silence),
         "stopped {silence:.1} ms after the last command (timeout 500 ms)"
     );
     // Held: re-sent every 50 ms until the stop, and nothing moved it after.
     let held: Vec<_> = moving.iter().filter(|f| f.0 > last_given).collect();
     assert!(held.len() >= 8, "re-sent {} times while held", held.len());
-    for pair in held.windows(2) {
-        let gap = ms_between(pair[0].0, pair[1].0);
-        assert!((40.0..=80.0).contains(&gap), "re-sent after {gap:.1} ms");
+    let gaps: Vec<f64> = held
+        .windows(2)
+        .map(|p| ms_between(p[0].0, p[1].0))
+        .collect();
+    for gap in &gaps {
+        assert!((40.0..=100.0).contains(gap), "re-sent after {gap:.1} ms");
     }
+    let mean = gaps.iter().sum::<f64>() / gaps.len() as f64;
+    assert!(
+        (48.0..=60.0).contains(&mean),
+        "re-sent every {mean:.1} ms on average"
+    );
     assert!(
         frames
             .iter()
@@ -150,7 +158,7 @@ fn the_v1_board_gets_mm_per_s_and_the_forced_stop_after_the_timeout() {
         .expect("the forced stop after the last command");
     let silence = ms_between(last_given, stop.0);
     assert!(
-        (500.0..=580.0).contains(&silence),
+        (500.0..=600.0).contains(&silence),
         "forced stop {silence:.1} ms after the last command"
     );
 }
