@@ -14,3 +14,13 @@ def pytest_configure(config: pytest.Config) -> None:
         pytest.exit(f"cannot make the private network namespace: {e}", returncode=4)
     except FileNotFoundError as e:
         pytest.exit(f"cannot make the private network namespace: `ip` is missing ({e})", 4)
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    from chassis_peer import report
+
+    lines = report.lines()
+    if lines:
+        terminalreporter.section("the node against the simulator")
+        for line in lines:
+            terminalreporter.write_line(line)

@@ -143,12 +143,14 @@ class Peer:
         """Whether the node's `/cmd_vel` reader has matched the writer."""
         return bool(self.cmd_vel.get_matched_subscriptions())
 
-    def wait_matched(self, timeout: float) -> bool:
-        """Waits up to `timeout` s for the node's `/cmd_vel` reader and every reader's writer."""
+    def wait_matched(self, timeout: float, topics: Optional[list[str]] = None) -> bool:
+        """Waits up to `timeout` s for the node's `/cmd_vel` reader and the node's writer on each
+        of `topics` (all the peer reads if None)."""
+        names = list(self.readers) if topics is None else topics
         end = time.monotonic() + timeout
         while time.monotonic() < end:
             if self.matched() and all(
-                r.get_matched_publications() for r, _ in self.readers.values()
+                self.readers[name][0].get_matched_publications() for name in names
             ):
                 return True
             time.sleep(0.02)

@@ -1,0 +1,25 @@
+"""Figures the end-to-end tests measure, printed in pytest's summary (`conftest.py`)."""
+
+drift: list[tuple[str, str, float, float, float]] = []
+"""(generation, path, position error m, heading error rad, path length m) for each odometry
+run."""
+
+stops: list[tuple[str, str, float]] = []
+"""(generation, what stopped it, board ms from the cause to the last pose change)."""
+
+
+def lines() -> list[str]:
+    """The figures as Markdown tables."""
+    out = []
+    if drift:
+        out += [
+            "| firmware | path | length | position error | heading error |",
+            "|---|---|---:|---:|---:|",
+        ]
+        for gen, path, pos, head, length in sorted(drift):
+            out.append(f"| {gen} | {path} | {length:.2f} m | {pos * 1000:.1f} mm | {head:.4f} rad |")
+    if stops:
+        out += ["", "| firmware | cause | stopped after (board time) |", "|---|---|---:|"]
+        for gen, cause, ms in sorted(stops):
+            out.append(f"| {gen} | {cause} | {ms:.0f} ms |")
+    return out

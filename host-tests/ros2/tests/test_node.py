@@ -1,0 +1,220 @@
+"""The node (`chassis-ros2`) driven from outside by the peer, against the simulated board of each
+firmware generation (`chassis sim --pty --pose FILE`), in the suite's private network namespace.
+The simulator's pose file is the truth: where the simulated chassis really is."""
+
+import math
+import signal
+import time
+
+import pytest
+
+from chassis_peer import cdr, dds, msgs, procs, report
+from chassis_peer.rig import Repeater, body_delta, rig, wrap
+
+GENERATIONS = procs.GENERATIONS
+
+if procs.chassis_bin() is None or procs.node_bin() is None:
+    pytest.skip(
+        "the binaries under test are not built (chassis: "
+        f"{procs.chassis_bin()}, chassis-ros2: {procs.node_bin()}): `cargo xtask ros2` builds "
+        "them, or set CHASSIS_BIN and CHASSIS_ROS2_BIN",
+        allow_module_level=True,
+    )
+
+SPEED = 0.25
+"""m/s for the motion checks."""
+TURN = 0.8
+"""rad/s for the motion checks."""
+
+POSITION_BOUND = 0.05
+"""m: how far `/odom` may end from the simulator's pose after the square or the circle."""
+HEADING_BOUND = 0.05
+"""rad: how far `/odom`'s heading may end from the simulator's."""
+STOP_SLACK = 0.25
+"""s: how long after the cause (timeout expiry, signal) the chassis may still move."""
+
+
+@pytest.mark.parametrize("firmware", GENERATIONS)
+@pytest.mark.parametrize(
+    "name, command, expect",
+    [
+        ("forward", (SPEED, 0.0, 0.0), (SPEED, 0.0, 0.0)),
+        ("backward", (-SPEED, 0.0, 0.0), (-SPEED, 0.0, 0.0)),
+        ("left (mecanum)", (0.0, SPEED, 0.0), (0.0, SPEED, 0.0)),
+        ("rotate CCW", (0.0, 0.0, TURN), (0.0, 0.0, TURN)),
+        ("rotate CW", (0.0, 0.0, -TURN), (0.0, 0.0, -TURN)),
+    ],
+)
+def test_chassis_moves_as_commanded(firmware, name, command, expect):
+    """One second of `/cmd_vel` moves the simulated chassis the commanded way: forward is +x of
+    the body, left +y (the simulated boards are mecanum), CCW +yaw (REP-103), each by the
+    commanded speed × 1 s within 25 %, the other axes by under 10 % of it."""
+    with rig(firmware) as r:
+        r.settle(0.3)
+        before = r.sim.pose()
+        r.peer.drive(*command, seconds=1.0)
+        r.settle(0.5)
+        after = r.sim.pose()
+        moved = body_delta(before, after)
+        seen = f"{name} on {firmware}: from {before} to {after}, body delta {moved}"
+        size = max(abs(e) for e in expect)
+        for axis, want, got in zip(("forward", "left", "yaw"), expect, moved):
+            if want:
+                assert math.copysign(1, got) == math.copysign(1, want), f"{axis} wrong way; {seen}"
+                assert abs(got - want) <= 0.25 * abs(want), f"{axis} by {got}, want {want}; {seen}"
+            else:
+                assert abs(got) <= 0.1 * size, f"{axis} moved {got}; {seen}"
+
+
+def _square(r) -> float:
+    side, speed, turn = 1.0, 0.5, 1.0
+    for _ in range(4):
+        r.peer.drive(speed, 0.0, 0.0, side / speed)
+        r.peer.drive(0.0, 0.0, turn, (math.pi / 2) / turn)
+    return 4 * side
+
+
+def _circle(r) -> float:
+    speed, turn = 0.5, 1.0
+    r.peer.drive(speed, 0.0, turn, 2 * math.pi / turn)
+    return 2 * math.pi * speed / turn
+
+
+@pytest.mark.parametrize("firmware", GENERATIONS)
+@pytest.mark.parametrize("path", ["1 m square", "circle r 0.5 m"])
+def test_odometry_ends_near_the_true_pose(firmware, path):
+    """After a 1 m square (0.5 m/s sides, 1 rad/s turns in place) or a full circle (0.5 m/s,
+    1 rad/s), then rest, `/odom`'s pose lies within POSITION_BOUND and HEADING_BOUND of the
+    simulator's own pose; `/tf` carries the same pose, odom → base_link."""
+    with rig(firmware) as r:
+        r.settle(0.3)
+        start = r.sim.pose()
+        length = _square(r) if path.endswith("square") else _circle(r)
+        stopped_at = time.monotonic()
+        r.settle(0.6)
+        truth = r.sim.pose()
+        odom = r.peer.wait_for("/odom", 2.0, since=stopped_at + 0.4)
+        assert odom is not None, f"no /odom after the run; node's stderr:\n{r.node.stderr()}"
+        o = odom.value
+        pose = o.pose.pose
+        yaw = msgs.yaw_of(pose.orientation)
+        pos_err = math.hypot(pose.position.x - truth.x, pose.position.y - truth.y)
+        head_err = abs(wrap(yaw - truth.yaw))
+        report.drift.append((firmware, path, pos_err, head_err, length))
+        seen = (
+            f"{path} on {firmware}: simulator from {start} to {truth}; /odom at "
+            f"({pose.position.x:.4f}, {pose.position.y:.4f}, yaw {yaw:.4f})"
+        )
+        assert (o.header.frame_id, o.child_frame_id) == ("odom", "base_link"), seen
+        assert pos_err <= POSITION_BOUND, f"position off by {pos_err:.4f} m; {seen}"
+        assert head_err <= HEADING_BOUND, f"heading off by {head_err:.4f} rad; {seen}"
+        tf = r.peer.wait_for("/tf", 2.0, since=stopped_at + 0.4)
+        assert tf is not None, "no /tf after the run"
+        (t,) = [t for t in tf.value.transforms if t.child_frame_id == "base_link"]
+        assert t.header.frame_id == "odom"
+        assert math.hypot(t.transform.translation.x - truth.x, t.transform.translation.y - truth.y) <= POSITION_BOUND
+        assert abs(wrap(msgs.yaw_of(t.transform.rotation) - truth.yaw)) <= HEADING_BOUND
+
+
+def _moving_then_still(r, cause_board_ms: int, seen: str) -> float:
+    """Waits 1.2 s, then the board ms from `cause_board_ms` to the last pose change; asserts the
+    pose then stays still to the end of the file."""
+    time.sleep(1.2)
+    poses = r.sim.poses()
+    last_change = None
+    for prev, cur in zip(poses, poses[1:]):
+        if (cur.x, cur.y, cur.yaw) != (prev.x, prev.y, prev.yaw):
+            last_change = cur.t_ms
+    assert last_change is not None, f"the chassis never moved; {seen}"
+    tail = [p for p in poses if p.t_ms >= last_change]
+    assert poses[-1].t_ms - last_change >= 700, (
+        f"still moving at the end of the pose file (last change at {last_change} ms, file "
+        f"ends at {poses[-1].t_ms} ms); {seen}"
+    )
+    assert len({(p.x, p.y, p.yaw) for p in tail}) == 1
+    return (last_change - cause_board_ms) / 1000.0
+
+
+@pytest.mark.parametrize("firmware", GENERATIONS)
+def test_cmd_vel_silence_stops_the_chassis(firmware):
+    """With `--cmd-vel-timeout 0.3`, the chassis driven at 20 Hz keeps moving past 0.15 s of
+    silence (the node waits for the timeout, not for the next command) and stops within the
+    timeout + STOP_SLACK of the last `/cmd_vel`."""
+    timeout = 0.3
+    with rig(firmware, extra=("--cmd-vel-timeout", str(timeout))) as r:
+        r.settle(0.3)
+        driver = Repeater(r.peer, SPEED, 0.0, 0.0)
+        time.sleep(1.0)
+        driver.stop()
+        last_board_ms = r.sim.pose().t_ms
+        after = _moving_then_still(r, last_board_ms, f"{firmware}, node stderr:\n{r.node.stderr()}")
+        report.stops.append((firmware, f"/cmd_vel silent ({timeout} s timeout)", after * 1000))
+        assert after >= 0.15, f"stopped {after:.3f} s after the last /cmd_vel, before its timeout"
+        assert after <= timeout + STOP_SLACK, f"stopped {after:.3f} s after the last /cmd_vel"
+
+
+@pytest.mark.parametrize("firmware", GENERATIONS)
+@pytest.mark.parametrize(
+    "sig, status", [(signal.SIGINT, 130), (signal.SIGTERM, 143), (signal.SIGHUP, 129)],
+    ids=["SIGINT", "SIGTERM", "SIGHUP"],
+)
+def test_signal_stops_the_chassis(firmware, sig, status):
+    """A signal to the node while `/cmd_vel` keeps coming stops the chassis within STOP_SLACK
+    (the cmd_vel timeout is 5 s, so it is the signal that stops it) and the node exits with
+    128 + the signal's number."""
+    with rig(firmware, timeout=5.0) as r:
+        driver = Repeater(r.peer, SPEED, 0.0, 0.0)
+        time.sleep(0.8)
+        moving = r.sim.pose()
+        code = r.node.signal(sig)
+        signalled_ms = moving.t_ms
+        after = _moving_then_still(r, signalled_ms, f"{firmware}, node stderr:\n{r.node.stderr()}")
+        driver.stop()
+        report.stops.append((firmware, signal.Signals(sig).name, after * 1000))
+        assert code == status, f"exit status {code}, want {status}; stderr:\n{r.node.stderr()}"
+        assert after <= STOP_SLACK, f"stopped {after:.3f} s after {signal.Signals(sig).name}"
+
+
+@pytest.mark.parametrize("firmware", GENERATIONS)
+def test_every_message_equals_the_independent_encoder(firmware):
+    """A sample of each topic as the node put it on the wire (raw CDR) equals `rosbags`
+    serializing the same field values; decoded with the declared types and re-encoded by
+    Cyclone DDS it gives the same bytes again (round trip). The frames and units ROS expects
+    are checked on the way."""
+    with rig(firmware) as r:
+        driver = Repeater(r.peer, SPEED, 0.1, 0.3)
+        since = time.monotonic() + 0.5
+        got = {t: r.peer.wait_for(t, 3.0, since=since) for t in dds.PUBLISHED}
+        driver.stop()
+        missing = [t for t, s in got.items() if s is None]
+        assert not missing, f"nothing on {missing}; node's stderr:\n{r.node.stderr()}"
+        for topic, sample in got.items():
+            value = sample.value
+            mismatch = cdr.wire_mismatch(sample.raw, cdr.rosbags_bytes(value))
+            assert mismatch is None, f"{topic} on {firmware}: {mismatch}\n value {value}"
+            mismatch = cdr.wire_mismatch(sample.raw, value.serialize())
+            assert mismatch is None, f"{topic} on {firmware} (round trip): {mismatch}"
+        odom = got["/odom"].value
+        assert odom.twist.twist.linear.x > 0.0, f"driving forward, /odom says {odom.twist}"
+        imu = got["/imu/data_raw"].value
+        assert imu.header.frame_id == "imu_link", imu.header
+        battery = got["/battery_state"].value
+        assert 5.0 < battery.voltage < 30.0, f"battery {battery.voltage} V"
+        assert battery.present
+        diagnostics = got["/diagnostics"].value
+        assert diagnostics.status, "an empty DiagnosticArray"
+
+
+@pytest.mark.parametrize("firmware", GENERATIONS)
+def test_stamped_and_no_tf(firmware):
+    """With `--stamped --no-tf`, `TwistStamped` commands drive the chassis forward and nothing
+    comes on `/tf` while `/odom` does."""
+    with rig(firmware, extra=("--stamped", "--no-tf"), stamped=True) as r:
+        before = r.sim.pose()
+        since = time.monotonic()
+        r.peer.drive(SPEED, 0.0, 0.0, seconds=1.0)
+        r.settle(0.3)
+        forward, _, _ = body_delta(before, r.sim.pose())
+        assert forward > 0.5 * SPEED, f"moved {forward} m forward on TwistStamped"
+        assert r.peer.samples("/odom", since), "no /odom"
+        assert not r.peer.samples("/tf"), "/tf published with --no-tf"
