@@ -90,6 +90,7 @@ class _Lines:
 
     def __init__(self, pipe) -> None:
         self.lines: list[str] = []
+        self.closed = False
         self._cond = threading.Condition()
         self._thread = threading.Thread(target=self._read, args=(pipe,), daemon=True)
         self._thread.start()
@@ -100,9 +101,12 @@ class _Lines:
                 self.lines.append(raw.decode(errors="replace").rstrip("\n"))
                 self._cond.notify_all()
         pipe.close()
+        with self._cond:
+            self.closed = True
+            self._cond.notify_all()
 
     def wait(self, prefix: str, timeout: float) -> Optional[str]:
-        """The first line starting with `prefix`, waiting up to `timeout` s."""
+        """The first line starting with `prefix`, waiting up to `timeout` s or the pipe's end."""
         end = time.monotonic() + timeout
         with self._cond:
             while True:
@@ -110,7 +114,7 @@ class _Lines:
                     if line.startswith(prefix):
                         return line
                 left = end - time.monotonic()
-                if left <= 0:
+                if left <= 0 or self.closed:
                     return None
                 self._cond.wait(left)
 
