@@ -1,6 +1,6 @@
 //! Which firmware the board runs, before a command talks to it: `--firmware` when given, else
 //! [`chassis_protocol::detect`] on the port (it listens first, and only on a quiet line sends
-//! its two harmless probes), and `chassis detect`, which says it in one line.
+//! its two harmless probes); what `chassis detect` says when nothing decided.
 
 use crate::port;
 use chassis_protocol::detect::{self, Detection, Firmware};
@@ -30,15 +30,15 @@ pub const SILENT: u8 = 3;
 pub const NEITHER: u8 = 4;
 
 /// Listens on `path` (and probes it if it is quiet).
-fn listen(path: &str) -> Result<Detection, String> {
+pub fn listen(path: &str) -> Result<Detection, String> {
     let mut serial = port::open_serial(path)?;
     let mut clock = MonotonicClock::new();
     detect::detect(&mut serial, &mut clock, &Config::HOST)
         .map_err(|e| format!("serial port {path}: {}", e.0))
 }
 
-/// The line `chassis detect` prints when nothing decided.
-fn undecided(path: &str, found: &Detection) -> (String, u8) {
+/// The line `chassis detect` prints when nothing decided, and its exit status.
+pub fn undecided(path: &str, found: &Detection) -> (String, u8) {
     let seconds = found.elapsed_ms as f64 / 1000.0;
     if found.heard.bytes == 0 {
         (
@@ -56,27 +56,6 @@ fn undecided(path: &str, found: &Detection) -> (String, u8) {
             NEITHER,
         )
     }
-}
-
-/// `chassis detect`: one line naming the firmware and what was heard (exit 0), or why none
-/// ([`SILENT`], [`NEITHER`]).
-pub fn detect_command(path: &str) -> Result<(), (String, u8)> {
-    let found = listen(path).map_err(|e| (e, 1))?;
-    let Some(firmware) = found.firmware else {
-        return Err(undecided(path, &found));
-    };
-    say!(
-        "firmware {} ({}) on {path}: heard {}{}",
-        firmware.name(),
-        firmware.framing(),
-        crate::generation::of(firmware).heard(&found.heard, found.elapsed_ms as f64 / 1000.0),
-        if found.probed {
-            " (after a register read of each firmware: the board was quiet)"
-        } else {
-            " (listening only: nothing was sent)"
-        }
-    );
-    Ok(())
 }
 
 /// The firmware `chassis check` talks to: `given`, or found on `path` (a silent line: the

@@ -3,52 +3,26 @@
 //! (a missing port, a file that is not there, odd hex, a value out of range, a silent board)
 //! is one line on stderr and a non-zero exit.
 
-/// `println!` that never panics: a closed pipe (`| head`) or a full disk on standard output
-/// must not end a command that may be driving the chassis. The command goes on, and its exit
-/// status stands.
-macro_rules! say {
-    ($($t:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stdout(), $($t)*);
-    }};
-}
-
-/// `eprintln!` that never panics (as [`say!`]).
-macro_rules! tell {
-    ($($t:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stderr(), $($t)*);
-    }};
-}
-
-/// `eprint!` that never panics, flushed (a question before an answer).
-macro_rules! tell_partial {
-    ($($t:tt)*) => {{
-        use std::io::Write as _;
-        let mut err = std::io::stderr();
-        let _ = write!(err, $($t)*);
-        let _ = err.flush();
-    }};
-}
+#[macro_use]
+extern crate chassis_cli;
 
 mod check;
-mod connect;
 mod decode;
+mod detect;
 mod driving;
 mod encode;
-mod ending;
 mod generation;
 mod input;
 mod monitor;
 mod names;
-mod newfile;
-mod port;
 mod record;
+mod ros2;
 mod sim;
-mod stopping;
 mod v1;
 mod v2020;
 mod value;
+
+use chassis_cli::{connect, ending, newfile, port, stopping};
 
 use chassis_protocol::detect::Firmware;
 use clap::{Parser, Subcommand};
@@ -149,6 +123,16 @@ enum Cmd {
         #[arg(long = "for", value_name = "SECONDS", allow_hyphen_values = true)]
         seconds: Option<f64>,
     },
+    /// Run the ROS 2 node (`chassis-ros2`, installed beside this tool or on PATH) with these
+    /// arguments: `chassis ros2 --port PATH [--firmware 2020|v1.0.0] [--params FILE.yaml]
+    /// [--stamped] [--no-tf] …` (`chassis ros2 --help` lists them). Its exit status is this
+    /// command's.
+    #[command(disable_help_flag = true)]
+    Ros2 {
+        /// The node's arguments, passed as given.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<std::ffi::OsString>,
+    },
     /// Serve a simulated board (prints where).
     Sim {
         /// On a new pseudo-terminal (prints its path).
@@ -188,7 +172,9 @@ impl Cmd {
     /// What the command is, for the ways it can end early.
     const fn kind(&self) -> ending::Kind {
         match self {
-            Cmd::Decode { .. } | Cmd::Encode { .. } | Cmd::Sim { .. } => ending::Kind::NoBoard,
+            Cmd::Decode { .. } | Cmd::Encode { .. } | Cmd::Sim { .. } | Cmd::Ros2 { .. } => {
+                ending::Kind::NoBoard
+            }
             Cmd::Drive { .. }
             | Cmd::Turn { .. }
             | Cmd::Monitor { .. }
@@ -208,6 +194,12 @@ impl Cmd {
 fn main() -> ExitCode {
     // First: a signal at any moment from here on has its documented effect.
     ending::catch_from_start();
+    // `chassis ros2 …`: every argument after `ros2` is the node's, its own `--port` included.
+    let mut argv = std::env::args_os().skip(1);
+    if argv.next().is_some_and(|first| first == "ros2") {
+        let args: Vec<std::ffi::OsString> = argv.collect();
+        return node_exit(ros2::run(&args));
+    }
     let cli = Cli::parse();
     ending::for_command(cli.command.kind());
     let result = options(&cli).and_then(|()| run(&cli));
@@ -221,6 +213,18 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err((message, code)) if message.is_empty() => ExitCode::from(code),
+        Err((message, code)) => {
+            last_words(format!("chassis: {message}\n"));
+            ExitCode::from(code)
+        }
+    }
+}
+
+/// The exit of `chassis ros2`: the node's status, or why it did not run.
+fn node_exit(result: Result<u8, (String, u8)>) -> ExitCode {
+    match result {
+        Ok(code) => ExitCode::from(code),
         Err((message, code)) => {
             last_words(format!("chassis: {message}\n"));
             ExitCode::from(code)
@@ -245,8 +249,23 @@ fn run(cli: &Cli) -> Result<(), (String, u8)> {
             faults,
             seed,
         } => sim::run(*pty, tcp.as_deref(), cli.firmware, *faults, *seed).map_err(failed),
+        Cmd::Ros2 { args } => {
+            // `chassis --port P --firmware F ros2 …`: the global options go to the node too.
+            let mut all: Vec<std::ffi::OsString> = Vec::new();
+            if let Some(port) = &cli.port {
+                all.extend(["--port".into(), port.into()]);
+            }
+            if let Some(firmware) = cli.firmware {
+                all.extend(["--firmware".into(), firmware.name().into()]);
+            }
+            all.extend(args.iter().cloned());
+            match ros2::run(&all)? {
+                0 => Ok(()),
+                code => Err((String::new(), code)),
+            }
+        }
         Cmd::Record { out, seconds } => record::record(path()?, out, *seconds).map_err(failed),
-        Cmd::Detect => connect::detect_command(path()?),
+        Cmd::Detect => detect::detect_command(path()?),
         Cmd::Check(check) => {
             let path = path()?;
             let firmware = connect::generation_for_check(path, cli.firmware)?;
@@ -299,6 +318,13 @@ fn options(cli: &Cli) -> Result<(), (String, u8)> {
         Cmd::Decode { .. } => ("decode", false),
         Cmd::Encode { .. } => ("encode", false),
         Cmd::Sim { .. } => ("sim", false),
+        Cmd::Ros2 { .. } if cli.record.is_some() => {
+            return Err((
+                "ros2: --record is not for the ROS 2 node (it talks to the board itself)".into(),
+                2,
+            ));
+        }
+        Cmd::Ros2 { .. } => ("ros2", true),
         Cmd::Record { .. } => ("record", true),
         _ => ("", true),
     };
