@@ -41,6 +41,7 @@
 //! | file | what |
 //! |---|---|
 //! | `line.rs` | the line to the master: pacing at 115 200 bps, its buffer, [`Faults`] |
+//! | `pose.rs` | the chassis's true pose, integrated every ms (each board's `pose`) |
 //! | `adapters.rs` | (feature `driver`) in-memory UART, clock and delay on shared simulated time |
 //! | `serve.rs` | (feature `std`) a board in real time on an OS byte stream |
 //!
@@ -65,10 +66,22 @@
 //! * Downlink: IMU at 100 Hz, encoders at 25 Hz, battery at 1 Hz, each with its rolling count;
 //!   simple kinematics for omni, mecanum and differential chassis move the encoders and gyro Z;
 //!   the battery drains.
+//! * **Axes** (decision A14 of `docs/protocol-2020.md`): X to the right, Y forward, Z
+//!   counter-clockwise, for every drive type, and a positive angle turns counter-clockwise.
+//!   The raw velocity units are wheel ticks per second; the chassis's geometry is in
+//!   [`SimConfig`] (1 000 ticks/m, half wheelbase 0.10 m, half track 0.12 m by default: 1 m/s
+//!   is 1 000 raw, 1 rad/s is 220 on a mecanum chassis). An angle turn moves the wheels too.
+//! * **Encoders** are running totals per wheel, wrapping at 16 bits.
+//! * **The true pose** ([`Board::pose`], and [`v1::Board::pose`]): where the body motion the
+//!   wheels make has taken the chassis since power-up, REP-103 axes, integrated every ms in
+//!   f64 by the board's own code, for an odometry to be measured against; `serve_observed`
+//!   (feature `std`) hands the board to a callback every N ms of board time to log it. A
+//!   chassis without encoders (open-loop differential) does not move in the model.
 
 #[cfg(feature = "driver")]
 mod adapters;
 mod line;
+mod pose;
 #[cfg(feature = "std")]
 mod serve;
 pub mod v1;
@@ -80,7 +93,7 @@ pub use adapters::SimDelay;
 pub use adapters::{SimClock, SimUart};
 pub use line::{Faults, OUT_CAPACITY};
 #[cfg(feature = "std")]
-pub use serve::serve;
+pub use serve::{serve, serve_observed, write_pose};
 pub use v2020::{Board, FACTORY, Motion, SimConfig};
 
 /// A simulated board's end of the wire: the line (pacing, faults), the parser of what the
@@ -174,6 +187,9 @@ macro_rules! wire_side {
             fn now_ms(&self) -> u64 {
                 Board::now_ms(self)
             }
+            fn pose(&self) -> Option<(f64, f64, f64)> {
+                Some(Board::pose(self))
+            }
         }
     };
 }
@@ -193,4 +209,10 @@ pub trait Simulated {
     fn byte_arrived(&self) -> bool;
     /// The board's time in ms.
     fn now_ms(&self) -> u64;
+    /// Where the chassis truly is, if the board tracks it: x, y (m) and yaw (rad, in
+    /// (-π, π]) since power-up, REP-103 axes (x forward, y left, yaw counter-clockwise). Both
+    /// boards do (their own `pose`); a wrapper that does not pass it on gives `None`.
+    fn pose(&self) -> Option<(f64, f64, f64)> {
+        None
+    }
 }

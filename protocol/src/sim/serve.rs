@@ -15,13 +15,66 @@ use std::time::{Duration, Instant};
 /// end of stream ends the run. Once stopped, what is already waiting is read before the board
 /// is given back. Bytes the other end does not take (a write that times out or
 /// would block) are dropped, as on a line nobody listens to: the board serves until stopped.
-pub fn serve<B: Simulated, T: Read + Write>(
+pub fn serve<B: Simulated, T: Read + Write>(board: B, io: T, stop: &AtomicBool) -> io::Result<B> {
+    run(board, io, stop, None)
+}
+
+/// [`serve`], with `observe` called on the board at its start and then every `every_ms` ms of
+/// board time (at exactly those times: the board's clock is stopped there for the call), for
+/// a log of its true pose ([`write_pose`]) or anything else a board tells. `every_ms` 0 is
+/// taken as 1.
+///
+/// ```no_run
+/// # fn pty() -> std::fs::File { unimplemented!() }
+/// use chassis_protocol::sim::{Board, SimConfig, serve_observed, write_pose};
+/// use std::sync::atomic::AtomicBool;
+///
+/// let mut log = std::io::BufWriter::new(std::fs::File::create("pose.txt")?);
+/// let stop = AtomicBool::new(false);
+/// // One line `t_ms x_m y_m yaw_rad` every 10 ms of board time.
+/// let mut observe = |board: &Board| {
+///     let _ = write_pose(&mut log, board);
+/// };
+/// serve_observed(Board::new(SimConfig::default()), pty(), &stop, 10, &mut observe)?;
+/// # Ok::<(), std::io::Error>(())
+/// ```
+pub fn serve_observed<B: Simulated, T: Read + Write>(
+    board: B,
+    io: T,
+    stop: &AtomicBool,
+    every_ms: u64,
+    observe: &mut dyn FnMut(&B),
+) -> io::Result<B> {
+    run(board, io, stop, Some((every_ms.max(1), observe)))
+}
+
+/// Writes one line, `t_ms x_m y_m yaw_rad` (the board's time; its true pose, REP-103 axes,
+/// to the µm and µrad), and flushes it; nothing for a board that does not track its pose.
+///
+/// # Errors
+///
+/// What writing to `out` gives.
+pub fn write_pose<B: Simulated, W: Write>(out: &mut W, board: &B) -> io::Result<()> {
+    if let Some((x, y, yaw)) = board.pose() {
+        writeln!(out, "{} {x:.6} {y:.6} {yaw:.6}", board.now_ms())?;
+        out.flush()?;
+    }
+    Ok(())
+}
+
+/// What [`serve_observed`] calls, and how often (ms of board time).
+type Observer<'o, B> = (u64, &'o mut dyn FnMut(&B));
+
+/// The loop of [`serve`] and [`serve_observed`].
+fn run<B: Simulated, T: Read + Write>(
     mut board: B,
     mut io: T,
     stop: &AtomicBool,
+    mut observer: Option<Observer<'_, B>>,
 ) -> io::Result<B> {
     let start = Instant::now();
     let offset = board.now_ms();
+    let mut next_observed = offset;
     let mut buf = [0u8; 256];
     while !stop.load(Ordering::Relaxed) {
         match io.read(&mut buf) {
@@ -39,7 +92,15 @@ pub fn serve<B: Simulated, T: Read + Write>(
             Err(e) => return Err(e),
         }
         let elapsed = u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX);
-        board.advance(offset.saturating_add(elapsed));
+        let now = offset.saturating_add(elapsed);
+        if let Some((every_ms, observe)) = observer.as_mut() {
+            while next_observed <= now {
+                board.advance(next_observed);
+                observe(&board);
+                next_observed = next_observed.saturating_add(*every_ms);
+            }
+        }
+        board.advance(now);
         loop {
             let n = board.transmit(&mut buf);
             if n == 0 {
@@ -141,5 +202,38 @@ mod tests {
             .expect("writes nobody takes are dropped, not an error");
         assert_eq!(board.commands(), 1, "the master's read was taken in");
         assert!(stop.load(Ordering::Relaxed), "it ran until stopped");
+    }
+
+    #[test]
+    fn the_observer_sees_the_board_every_10_ms_of_its_time() {
+        let stop = AtomicBool::new(false);
+        let io = NobodyReads {
+            sent: false,
+            turns: 0,
+            stop: &stop,
+        };
+        let mut lines = Vec::new();
+        let mut observe = |board: &Board| write_pose(&mut lines, board).unwrap();
+        let board = serve_observed(
+            Board::new(SimConfig::default()),
+            io,
+            &stop,
+            10,
+            &mut observe,
+        )
+        .expect("writes nobody takes are dropped, not an error");
+        let text = String::from_utf8(lines).unwrap();
+        let times: Vec<u64> = text
+            .lines()
+            .map(|l| l.split(' ').next().unwrap().parse().unwrap())
+            .collect();
+        // From 0, every 10 ms, up to the board's last time.
+        let expected: Vec<u64> = (0..=board.now_ms() / 10).map(|k| k * 10).collect();
+        assert_eq!(times, expected);
+        // Standing still at the origin all along: four fields, each 0 to the µm.
+        assert!(
+            text.lines()
+                .all(|l| l.ends_with(" 0.000000 0.000000 0.000000"))
+        );
     }
 }

@@ -32,6 +32,8 @@
 //!   raw = 1 g, i.e. milli-g, chosen). No sensor noise: every value is what was commanded.
 //! * **Yaw** integrates the measured wz every ms (µrad), kept in (-π, π]; the quaternion is the
 //!   rotation about z by it, × 1000: (cos yaw/2, 0, 0, sin yaw/2), so w ≥ 0.
+//! * **True pose** ([`Board::pose`]): the measured body velocity integrated every ms in f64,
+//!   in REP-103 axes (x forward = the board's vy, y left = −vx, yaw counter-clockwise = wz).
 //! * **Battery** starts at [`START_MV`] and drains 1 mV every 2 s while moving, every 20 s
 //!   standing.
 //! * **No watchdog**, as none is documented: the last velocity is kept until another command.

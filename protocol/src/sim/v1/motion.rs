@@ -2,6 +2,7 @@
 //! moves at, the yaw it turns by, the battery; the mecanum kinematics both ways.
 
 use super::Board;
+use crate::sim::pose::{Pose, sin_cos};
 use crate::v1::{BodyVelocity, MotorVelocity};
 
 /// Battery voltage at power-up, mV.
@@ -18,8 +19,9 @@ pub(super) enum Drive {
     Motors(MotorVelocity),
 }
 
-/// What the chassis does: what the wheels were last told, the heading, the battery.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// What the chassis does: what the wheels were last told, the heading, the battery, where it
+/// truly is.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Chassis {
     /// What the wheels were last told.
     pub(super) drive: Drive,
@@ -27,6 +29,8 @@ pub(super) struct Chassis {
     pub(super) yaw_urad: i64,
     /// The battery, mV.
     pub(super) battery_mv: i16,
+    /// The true pose (REP-103 axes), the measured velocity integrated every ms.
+    pub(super) pose: Pose,
 }
 
 impl Chassis {
@@ -36,16 +40,25 @@ impl Chassis {
             drive: Drive::Body(BodyVelocity::FORCED_STOP),
             yaw_urad: 0,
             battery_mv: START_MV,
+            pose: Pose::new(),
         }
     }
 }
 
 impl Board {
-    /// One ms of motion: the heading turns by wz, the battery drains (faster while moving).
+    /// One ms of motion: the heading turns by wz, the chassis moves (its true pose), the
+    /// battery drains (faster while moving).
     pub(super) fn move_chassis(&mut self, now: u64) {
-        let [_, _, wz] = self.measured_velocity();
+        let [vx, vy, wz] = self.measured_velocity();
         // mrad/s for 1 ms: µrad.
         self.chassis.yaw_urad = wrap_yaw(self.chassis.yaw_urad.saturating_add(i64::from(wz)));
+        // mm/s and mrad/s for 1 ms: µm and µrad. The board's vx is to the right, vy forward
+        // (see the module's kinematics): REP-103's forward is vy, its left is -vx.
+        self.chassis.pose.advance(
+            f64::from(vy) * 1e-6,
+            -f64::from(vx) * 1e-6,
+            f64::from(wz) * 1e-6,
+        );
         let moving = self.measured_velocity() != [0; 3];
         let drain_every = if moving { 2_000 } else { 20_000 };
         if now.checked_rem(drain_every) == Some(0) {
@@ -105,6 +118,14 @@ impl Board {
     #[must_use]
     pub const fn yaw_urad(&self) -> i64 {
         self.chassis.yaw_urad
+    }
+
+    /// Where the chassis truly is: x, y (m) and yaw (rad, in (-π, π]) since power-up, REP-103
+    /// axes (x forward, y left, yaw counter-clockwise), the measured body velocity integrated
+    /// every ms. What an odometry built on the telemetry is measured against.
+    #[must_use]
+    pub const fn pose(&self) -> (f64, f64, f64) {
+        self.chassis.pose.get()
     }
 
     /// The battery voltage, mV.
@@ -167,23 +188,6 @@ pub(super) fn wrap_yaw(yaw: i64) -> i64 {
 pub(super) fn quaternion(yaw_urad: i64) -> [i16; 4] {
     let (sin, cos) = sin_cos(yaw_urad as f64 / 2_000_000.0);
     [milli(cos), 0, 0, milli(sin)]
-}
-
-/// Sine and cosine of `x` (|x| ≤ π/2) by their Taylor series to x¹⁵ and x¹⁴ (error < 1e-9;
-/// `core` has no `sin`).
-fn sin_cos(x: f64) -> (f64, f64) {
-    let x2 = x * x;
-    let (mut sin, mut cos) = (x, 1.0);
-    let (mut sin_term, mut cos_term) = (x, 1.0);
-    let mut k = 0.0;
-    for _ in 0..7 {
-        k += 2.0;
-        cos_term *= -x2 / ((k - 1.0) * k);
-        sin_term *= -x2 / (k * (k + 1.0));
-        cos += cos_term;
-        sin += sin_term;
-    }
-    (sin, cos)
 }
 
 /// `v` × 1000, rounded (half away from 0).

@@ -556,3 +556,56 @@ fn the_sim_uart_takes_the_v1_board() {
     assert_eq!(uart.board().total_commands(), 1);
     uart.board_mut().set_faults(Faults::default());
 }
+
+/// vy 0.25 m/s (00FA), ctl 2, type 4: 7B^25^02^04^FA = A2.
+const FORWARD_250: [u8; 14] = [
+    0x7B, 0x25, 0x02, 0x04, 0, 0, 0x00, 0xFA, 0, 0, 0, 0, 0xA2, 0x7D,
+];
+/// vx 0.25 m/s (00FA), to the right: 7B^25^02^04^FA = A2.
+const RIGHT_250: [u8; 14] = [
+    0x7B, 0x25, 0x02, 0x04, 0x00, 0xFA, 0, 0, 0, 0, 0, 0, 0xA2, 0x7D,
+];
+
+#[test]
+fn forward_for_4_s_at_250_mm_s_is_1_m_of_true_pose() {
+    let mut bench = Bench::new(SimConfig::default());
+    bench.send(&FORWARD_250, 4_000);
+    bench.send(&FORCED_STOP, 1_000);
+    let (x, y, yaw) = bench.board.pose();
+    // 0.25 m/s for 4 000 ms, each ms 250 µm.
+    assert!(
+        (x - 1.0).abs() < 1e-9 && y.abs() < 1e-12 && yaw == 0.0,
+        "{x} {y} {yaw}"
+    );
+}
+
+#[test]
+fn the_true_pose_is_in_rep_103_axes() {
+    // vx is to the right: REP-103's -y.
+    let mut bench = Bench::new(SimConfig::default());
+    bench.send(&RIGHT_250, 4_000);
+    bench.send(&FORCED_STOP, 10);
+    let (x, y, _) = bench.board.pose();
+    assert!(x.abs() < 1e-12 && (y + 1.0).abs() < 1e-9, "{x} {y}");
+    // wz 0.5 rad/s for 2 s, counter-clockwise; the true yaw is the board's own heading.
+    let mut turning = Bench::new(SimConfig::default());
+    turning.send(&TURN, 2_000);
+    turning.send(&FORCED_STOP, 10);
+    let (_, _, yaw) = turning.board.pose();
+    assert!((yaw - 1.0).abs() < 1e-9, "{yaw}");
+    assert!((yaw - turning.board.yaw_urad() as f64 / 1e6).abs() < 1e-9);
+}
+
+#[test]
+fn driving_while_turning_traces_the_circle() {
+    // 0.3 m/s forward and 0.5 rad/s (DRIVE has vx -0.1 m/s too: 0.1 m/s to the left).
+    // For 4π s: once round a circle, back at the start.
+    let mut bench = Bench::new(SimConfig::default());
+    let full_turn_ms = (4.0 * std::f64::consts::PI * 1_000.0).round() as u64;
+    bench.send(&DRIVE, full_turn_ms);
+    bench.send(&FORCED_STOP, 10);
+    let (x, y, yaw) = bench.board.pose();
+    // 12 566 ms against 12 566.37: a shortfall of 0.37 ms, 0.2 mrad, at most 0.12 mm off.
+    assert!(x.hypot(y) < 2e-4, "({x}, {y})");
+    assert!(yaw.abs() < 3e-4, "{yaw}");
+}

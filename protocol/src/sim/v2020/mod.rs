@@ -12,6 +12,8 @@ use heapless::Deque;
 mod motion;
 mod registers;
 mod telemetry;
+#[cfg(test)]
+mod tests;
 
 use motion::Chassis;
 pub use motion::Motion;
@@ -29,6 +31,13 @@ pub struct SimConfig {
     pub reply_delay_ms: u32,
     /// Downlink resumes this long after the last settings frame, in ms.
     pub resume_after_ms: u32,
+    /// Encoder ticks per metre a wheel's rim travels (1 000). The raw velocity units are wheel
+    /// ticks per second, so on a mecanum chassis 1 m/s forward is Y = `ticks_per_m`.
+    pub ticks_per_m: u32,
+    /// From the centre to the front and rear axles, mm (100).
+    pub half_wheelbase_mm: u16,
+    /// From the centre to a wheel sideways, mm (120; a differential chassis: half its track).
+    pub half_track_mm: u16,
 }
 
 impl Default for SimConfig {
@@ -37,6 +46,9 @@ impl Default for SimConfig {
             seed: 1,
             reply_delay_ms: 2,
             resume_after_ms: 100,
+            ticks_per_m: 1_000,
+            half_wheelbase_mm: 100,
+            half_track_mm: 120,
         }
     }
 }
@@ -101,6 +113,22 @@ impl Board {
     #[must_use]
     pub const fn motion(&self) -> Motion {
         self.chassis.motion
+    }
+
+    /// Where the chassis truly is: x, y (m) and yaw (rad, in (-π, π]) since power-up, REP-103
+    /// axes (x forward, y left, yaw counter-clockwise): the body motion its wheels make,
+    /// integrated every ms with the geometry of [`SimConfig`]. What an odometry built on the
+    /// encoders is measured against.
+    #[must_use]
+    pub const fn pose(&self) -> (f64, f64, f64) {
+        self.chassis.pose.get()
+    }
+
+    /// The encoders' running totals (wrapping 16-bit), MOTO1..MOTO4: what the next encoder
+    /// frame will carry.
+    #[must_use]
+    pub const fn wheel_ticks(&self) -> [i16; 4] {
+        self.chassis.wheel_ticks
     }
 
     /// The turn still pending, in 0.1°.
