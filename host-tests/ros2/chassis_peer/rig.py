@@ -25,17 +25,6 @@ class Rig:
         """Publishes zero velocity at 20 Hz for `seconds` (the chassis comes to rest)."""
         self.peer.drive(0.0, 0.0, 0.0, seconds)
 
-    def still_since(self, window_ms: int = 200) -> bool:
-        """Whether the simulator's pose has not changed over its last `window_ms` of board time."""
-        poses = self.sim.poses()
-        if not poses:
-            return False
-        last = poses[-1]
-        recent = [p for p in poses if p.t_ms >= last.t_ms - window_ms]
-        return recent[0].t_ms <= last.t_ms - window_ms + 10 and all(
-            (p.x, p.y, p.yaw) == (last.x, last.y, last.yaw) for p in recent
-        )
-
 
 @contextlib.contextmanager
 def rig(
