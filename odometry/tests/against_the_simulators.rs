@@ -125,6 +125,7 @@ fn the_2020_encoders_follow_the_boards_true_pose() {
     }
     board.receive(&Velocity::STOP.encode());
     run(&mut board, 200, &mut odometry);
+    println!("{frames} encoder frames heard");
     assert!(frames > 250, "{frames} encoder frames heard");
 
     // The board went where the twists say: its raw scale and axes are the odometry's. (The
@@ -168,6 +169,7 @@ fn the_v1_telemetry_follows_the_boards_true_pose() {
     }
     board.receive(&v1::Command::BodyVelocity(BodyVelocity::FORCED_STOP).encode());
     run(&mut board, 200, &mut odometry);
+    println!("{frames} telemetry frames heard");
     assert!(frames > 200, "{frames} telemetry frames heard");
 
     assert_near("true pose", board.pose(), expected_end(), 1e-6, 1e-6);

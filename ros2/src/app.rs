@@ -92,11 +92,15 @@ pub fn parameters(args: &Args) -> Result<Params, String> {
         overrides.push(("publish_tf".into(), "false".into()));
     }
     let yaml = text.as_deref().zip(args.params.as_deref());
-    params::parse(yaml, &args.name, &overrides)
+    let params = params::parse(yaml, &args.name, &overrides)?;
+    crate::odom::geometry(&params)
+        .validate()
+        .map_err(|e| format!("the chassis geometry: {e}"))?;
+    Ok(params)
 }
 
 /// The IMU's scale: the parameters', else the generation's assumption (and a note saying so).
-fn imu_scale(params: &Params, firmware: &str) -> (ImuScale, Option<String>) {
+pub fn imu_scale(params: &Params, firmware: &str) -> (ImuScale, Option<String>) {
     let (accel, gyro) = if firmware == DriverCore::NAME {
         (
             params::DEFAULT_ACCEL_PER_G_2020,

@@ -4,7 +4,7 @@
 //! `chassis` tool's ([`chassis_cli`]): the node opens and stops a board exactly as every
 //! `chassis` command does.
 
-use crate::odom::{RawScale, Twist2};
+use crate::odom::{RawScale, Twist2, v1_twist, v1_yaw};
 use chassis_cli::port;
 use chassis_cli::stopping::{self, HostDriver, Spoken, Stopped};
 use chassis_protocol::driver::host::SerialError;
@@ -179,12 +179,6 @@ fn unit_quaternion(q: [i16; 4]) -> Option<[f64; 4]> {
         .then(|| [x / norm, y / norm, z / norm, w / norm])
 }
 
-/// The yaw (rad, counter-clockwise about z) of a unit quaternion (x, y, z, w).
-pub fn yaw_of(q: [f64; 4]) -> f64 {
-    let [x, y, z, w] = q;
-    (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z))
-}
-
 impl Generation for v1::DriverCore {
     const NAME: &'static str = "v1.0.0";
 
@@ -192,8 +186,8 @@ impl Generation for v1::DriverCore {
         port::open_v1(path, None)
     }
 
-    /// The board's vx is sideways to the right and vy forward (the simulated board's axes):
-    /// REP-103's x forward is its vy, y to the left its −vx.
+    /// The board's vx is sideways to the right and vy forward (the simulated board's axes, as
+    /// [`v1_twist`] reads them back): REP-103's x forward is its vy, y to the left its −vx.
     fn send(
         driver: &mut HostDriver<Self>,
         twist: Twist2,
@@ -210,22 +204,16 @@ impl Generation for v1::DriverCore {
         let v1::Event::Telemetry(t) = event else {
             return Vec::new();
         };
-        let [vx, vy, wz] = t.velocity.map(|v| f32::from(v) / 1000.0);
-        let orientation = unit_quaternion(t.quaternion);
         vec![
             Reading::Body {
-                twist: Twist2 {
-                    vx: vy,
-                    vy: -vx,
-                    wz,
-                },
-                yaw: orientation.map(|q| yaw_of(q) as f32),
+                twist: v1_twist(t),
+                yaw: v1_yaw(t),
                 at_ms: driver.uart().now_ms(),
             },
             Reading::Imu {
                 accel: t.accel,
                 gyro: t.gyro,
-                orientation,
+                orientation: unit_quaternion(t.quaternion),
             },
             Reading::Battery {
                 volts: f32::from(t.battery_mv) / 1000.0,
@@ -275,11 +263,12 @@ mod tests {
     }
 
     #[test]
-    fn the_v1_quaternion_is_normalised_and_its_yaw_read() {
-        // 90° about z: (cos 45°, 0, 0, sin 45°) × 1000 = (707, 0, 0, 707).
+    fn the_v1_quaternion_is_normalised() {
+        // 90° about z: (cos 45°, 0, 0, sin 45°) × 1000 = (707, 0, 0, 707), norm 0.99985.
         let q = unit_quaternion([707, 0, 0, 707]).unwrap();
         assert!((q[2] - core::f64::consts::FRAC_1_SQRT_2).abs() < 1e-12);
-        assert!((yaw_of(q) - core::f64::consts::FRAC_PI_2).abs() < 1e-9);
+        assert_eq!(q[2], q[3]);
+        assert_eq!((q[0], q[1]), (0.0, 0.0));
         assert_eq!(unit_quaternion([1000, 0, 0, 0]), Some([0.0, 0.0, 0.0, 1.0]));
         assert_eq!(unit_quaternion([0, 0, 0, 0]), None);
         assert_eq!(unit_quaternion([i16::MAX; 4]), None);

@@ -246,6 +246,7 @@ impl<K: Generation, I: Io> Node<'_, K, I> {
                             self.latency.add(u64::try_from(ns).unwrap_or(0));
                         }
                     }
+                    Err(_) if ending::ended().is_some() => {}
                     Err(e) => {
                         self.counters.send_errors = self.counters.send_errors.saturating_add(1);
                         let words = stopping::explain(&self.driver, e);
@@ -282,6 +283,8 @@ impl<K: Generation, I: Io> Node<'_, K, I> {
                     }
                 }
                 Ok(None) => break,
+                // The port's waits end once a signal came: the loop's next turn stops.
+                Err(_) if ending::ended().is_some() => break,
                 Err(e) => {
                     let words = stopping::explain(&self.driver, e);
                     self.once("poll", format!("reading the board: {words} (still trying)"));

@@ -241,7 +241,6 @@ impl Params {
             ("cmd_vel_timeout", Some(self.cmd_vel_timeout)),
             ("odom_rate", Some(self.odom_rate)),
             ("diagnostics_rate", Some(self.diagnostics_rate)),
-            ("half_wheelbase", Some(self.half_wheelbase)),
             ("half_track", Some(self.half_track)),
             ("ticks_per_meter", Some(self.ticks_per_meter)),
             ("accel_per_g", self.accel_per_g),
@@ -283,6 +282,12 @@ impl Params {
                     "parameter {name}: {v} is not a finite number of at least 0"
                 ));
             }
+        }
+        if !(self.half_wheelbase.is_finite() && self.half_wheelbase >= 0.0) {
+            return Err(format!(
+                "parameter half_wheelbase: {} is not a finite number of metres, 0 or more",
+                self.half_wheelbase
+            ));
         }
         if self.cmd_vel_timeout > 3600.0 {
             return Err(format!(

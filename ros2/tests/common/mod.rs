@@ -57,7 +57,8 @@ pub struct Sim {
     /// Set: the board's bytes no longer reach the node.
     pub mute: Arc<AtomicBool>,
     stop: Arc<AtomicBool>,
-    thread: Option<JoinHandle<()>>,
+    /// The board's true pose when it stopped: x, y (m), yaw (rad).
+    thread: Option<JoinHandle<Option<(f64, f64, f64)>>>,
     /// The other end, kept open so that the line stays up between the node's opens.
     _slave: serialport::TTYPort,
 }
@@ -81,7 +82,9 @@ impl Sim {
         };
         let stopping = Arc::clone(&stop);
         let thread = std::thread::spawn(move || {
-            let _ = chassis_protocol::sim::serve(board, tap, &stopping);
+            chassis_protocol::sim::serve(board, tap, &stopping)
+                .ok()
+                .and_then(|board| chassis_protocol::sim::Simulated::pose(&board))
         });
         Sim {
             path,
@@ -136,6 +139,17 @@ impl Sim {
             }
         }
         out
+    }
+}
+
+impl Sim {
+    /// Stops the board: where it truly is (x, y in m, yaw in rad, REP-103).
+    pub fn true_pose(mut self) -> (f64, f64, f64) {
+        self.stop.store(true, Ordering::Relaxed);
+        self.thread
+            .take()
+            .and_then(|t| t.join().ok().flatten())
+            .expect("the board's pose")
     }
 }
 
