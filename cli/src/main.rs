@@ -147,6 +147,11 @@ enum Cmd {
         /// Seed of the board's noise and faults.
         #[arg(long, default_value = "1")]
         seed: u64,
+        /// Write the board's true pose to FILE every 10 ms of board time, one line
+        /// `t_ms x_m y_m yaw_rad` (x forward, y left, yaw counter-clockwise, since power-up;
+        /// with --tcp, each client's board starts the file afresh).
+        #[arg(long, value_name = "FILE")]
+        pose: Option<std::path::PathBuf>,
     },
 }
 
@@ -248,7 +253,16 @@ fn run(cli: &Cli) -> Result<(), (String, u8)> {
             tcp,
             faults,
             seed,
-        } => sim::run(*pty, tcp.as_deref(), cli.firmware, *faults, *seed).map_err(failed),
+            pose,
+        } => sim::run(
+            *pty,
+            tcp.as_deref(),
+            cli.firmware,
+            *faults,
+            *seed,
+            pose.as_deref(),
+        )
+        .map_err(failed),
         Cmd::Ros2 { args } => {
             // `chassis --port P --firmware F ros2 …`: the global options go to the node too.
             let mut all: Vec<std::ffi::OsString> = Vec::new();

@@ -2,8 +2,12 @@
 //! every command can be tried without hardware (and the QEMU firmware has a chassis to drive).
 //! Either firmware generation: the 2020 board (`FF FE` frames) or the v1.0.0 one (`7B … 7D`).
 
-use chassis_protocol::sim::{self, Board, Faults, SimConfig, Simulated, serve};
+use chassis_protocol::sim::{
+    self, Board, Faults, SimConfig, Simulated, serve, serve_observed, write_pose,
+};
+use std::io::{self, BufWriter, Read, Write};
 use std::net::TcpListener;
+use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 use chassis_protocol::detect::Firmware;
@@ -46,26 +50,43 @@ pub fn board_v1(seed: u64, faults: Faults) -> sim::v1::Board {
 
 /// `chassis sim`: serves the simulated board of `firmware` (2020 unless given) on a new
 /// pseudo-terminal (`pty`) or to each client of a TCP listener on `tcp`, until the process is
-/// stopped; prints where.
+/// stopped; prints where. With `pose`, the board's true pose goes to that file every 10 ms of
+/// board time (`t_ms x_m y_m yaw_rad`, REP-103 axes), for an odometry to be measured against.
 pub fn run(
     pty: bool,
     tcp: Option<&str>,
     firmware: Option<Firmware>,
     rate: f64,
     seed: u64,
+    pose: Option<&Path>,
 ) -> Result<(), String> {
     let faults = faults(rate)?;
-    let place = match (pty, tcp) {
-        (true, _) => Place::Pty,
-        (false, Some(addr)) => Place::Tcp(addr),
+    let at = match (pty, tcp) {
+        (true, _) => Where::Pty,
+        (false, Some(addr)) => Where::Tcp(addr),
         (false, None) => return Err("sim: give --pty or --tcp ADDR".into()),
     };
-    crate::generation::of(firmware.unwrap_or(crate::connect::DEFAULT_FIRMWARE))
-        .simulate(&place, seed, faults)
+    if let Some(file) = pose {
+        // Made now, so that a path that cannot be written is said before anything is served.
+        std::fs::File::create(file).map_err(|e| format!("--pose {}: {e}", file.display()))?;
+    }
+    crate::generation::of(firmware.unwrap_or(crate::connect::DEFAULT_FIRMWARE)).simulate(
+        &Place { at, pose },
+        seed,
+        faults,
+    )
+}
+
+/// Where the board is served, and where its true pose is written.
+pub struct Place<'a> {
+    /// A pseudo-terminal or a TCP listener.
+    pub at: Where<'a>,
+    /// The file the true pose goes to, if any.
+    pub pose: Option<&'a Path>,
 }
 
 /// Where the board is served.
-pub enum Place<'a> {
+pub enum Where<'a> {
     /// A new pseudo-terminal.
     Pty,
     /// A TCP listener on this address.
@@ -81,17 +102,44 @@ impl Place<'_> {
         commands: impl Fn(&B) -> u32,
         hint: &str,
     ) -> Result<(), String> {
-        match self {
-            Place::Pty => on_pty(fresh(), hint),
-            Place::Tcp(addr) => on_tcp(addr, fresh, commands),
+        match self.at {
+            Where::Pty => on_pty(fresh(), self.pose, hint),
+            Where::Tcp(addr) => on_tcp(addr, fresh, commands, self.pose),
         }
     }
+}
+
+/// [`serve`], the board's true pose written to `pose` (made afresh) every 10 ms of board time.
+fn serve_posing<B: Simulated, T: Read + Write>(
+    board: B,
+    io: T,
+    stop: &AtomicBool,
+    pose: Option<&Path>,
+) -> io::Result<B> {
+    let Some(file) = pose else {
+        return serve(board, io, stop);
+    };
+    let mut log = BufWriter::new(std::fs::File::create(file)?);
+    let mut failed = false;
+    let mut observe = |board: &B| {
+        // A full disk ends the log, not the board.
+        if !failed && write_pose(&mut log, board).is_err() {
+            failed = true;
+            tell!(
+                "chassis sim: --pose {}: cannot write; no more poses",
+                file.display()
+            );
+        }
+    };
+    let board = serve_observed(board, io, stop, 10, &mut observe)?;
+    let _ = log.flush();
+    Ok(board)
 }
 
 /// Serves `board` on a new pseudo-terminal; `hint` (with `{path}` in it) follows the path on
 /// stderr.
 #[cfg(unix)]
-fn on_pty<B: Simulated>(board: B, hint: &str) -> Result<(), String> {
+fn on_pty<B: Simulated>(board: B, pose: Option<&Path>, hint: &str) -> Result<(), String> {
     use serialport::SerialPort as _;
     let (mut board_end, master_end) =
         serialport::TTYPort::pair().map_err(|e| format!("cannot make a pseudo-terminal: {e}"))?;
@@ -106,7 +154,7 @@ fn on_pty<B: Simulated>(board: B, hint: &str) -> Result<(), String> {
     // client has the path open.
     let keep = master_end;
     let stop = AtomicBool::new(false);
-    let result = serve(board, board_end, &stop);
+    let result = serve_posing(board, board_end, &stop, pose);
     drop(keep);
     result
         .map(|_| ())
@@ -115,7 +163,7 @@ fn on_pty<B: Simulated>(board: B, hint: &str) -> Result<(), String> {
 
 /// No pseudo-terminals off Unix.
 #[cfg(not(unix))]
-fn on_pty<B: Simulated>(_board: B, _hint: &str) -> Result<(), String> {
+fn on_pty<B: Simulated>(_board: B, _pose: Option<&Path>, _hint: &str) -> Result<(), String> {
     Err("--pty needs a Unix pseudo-terminal; use --tcp".into())
 }
 
@@ -125,6 +173,7 @@ fn on_tcp<B: Simulated>(
     addr: &str,
     fresh: impl Fn() -> B,
     commands: impl Fn(&B) -> u32,
+    pose: Option<&Path>,
 ) -> Result<(), String> {
     let listener = TcpListener::bind(addr).map_err(|e| format!("cannot listen on {addr}: {e}"))?;
     let local = listener.local_addr().map_err(|e| format!("{addr}: {e}"))?;
@@ -141,7 +190,7 @@ fn on_tcp<B: Simulated>(
             .map_err(|e| format!("{peer}: {e}"))?;
         tell!("chassis sim: {peer} connected");
         let stop = AtomicBool::new(false);
-        match serve(fresh(), stream, &stop) {
+        match serve_posing(fresh(), stream, &stop, pose) {
             Ok(board) => tell!(
                 "chassis sim: {peer} left after {:.1} s ({} commands)",
                 board.now_ms() as f64 / 1000.0,

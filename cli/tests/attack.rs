@@ -7,8 +7,8 @@
 //! after (2020: the stop frame, a turn cancelled; v1.0.0: the forced stop); the process ended
 //! within [`EXIT_BOUND`] of the ending, with the ending's exit status and a message that says
 //! what happened. A command that had ended, or was failing, on its own before the ending came (a
-//! check whose simulated board a loaded machine starved) is judged on the chassis alone, and
-//! counted apart. The table (command × ending: runs, moved, stopped, exit statuses, the worst
+//! check whose simulated board a loaded machine starved: the board's serving loop stood still
+//! for 100 ms or more before the ending) is judged on the chassis alone, and counted apart. The table (command × ending: runs, moved, stopped, exit statuses, the worst
 //! time to stop and to exit, at which moment) is printed, and written to
 //! `target/attack-table.md`; every run's row to `target/attack-runs.md`.
 
@@ -200,6 +200,13 @@ impl Board {
         }
     }
 
+    fn stalled_before(&self, at: Instant) -> bool {
+        match self {
+            Board::V2020(b) => b.stalled_before(at),
+            Board::V1(b) => b.stalled_before(at),
+        }
+    }
+
     fn heard_by(&self, len: usize) -> Option<Instant> {
         match self {
             Board::V2020(b) => b.heard_by(len),
@@ -352,7 +359,7 @@ fn run(index: usize, ending: Ending, moment_ms: u64, dir: &std::path::Path) -> O
     // (A monitor refusing a standard input that is not a terminal ends at once: that is its
     // answer, judged as such below.)
     let refused = case.needs_terminal && ending == Ending::InputEnded;
-    let ended_first =
+    let mut ended_first =
         !refused && (started.child().try_wait().unwrap().is_some() || so_far.contains("FAIL"));
     let mut said = String::new();
     match (&mut started, ending) {
@@ -418,6 +425,10 @@ fn run(index: usize, ending: Ending, moment_ms: u64, dir: &std::path::Path) -> O
     }
     // What reached the board in its last moments is in before the verdict.
     std::thread::sleep(Duration::from_millis(20));
+    // A board the machine starved before the ending went quiet by no fault of the command,
+    // which may already have been failing on it when the ending came (its words not written
+    // yet): its exit and words are its own, what became of the chassis is judged all the same.
+    ended_first |= !refused && board.stalled_before(ended_at);
     let heard = board.heard();
     let heard_len = heard.len();
     // When the last stop arrived (the board still serving keeps the times).

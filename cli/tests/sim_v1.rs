@@ -104,3 +104,53 @@ fn an_unknown_firmware_is_a_clear_error() {
     );
     assert!(out.stdout.is_empty());
 }
+
+/// 0.3 m/s forward, as `docs/protocol-v1.md`'s example writes it.
+const FORWARD_300: [u8; 14] = [
+    0x7B, 0x25, 0x02, 0x04, 0x00, 0x00, 0x01, 0x2C, 0x00, 0x00, 0x00, 0x00, 0x75, 0x7D,
+];
+
+#[test]
+fn sim_pose_writes_the_true_pose_as_the_chassis_drives() {
+    let dir = std::env::temp_dir().join(format!("chassis-sim-pose-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("pose.txt");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_chassis"))
+        .args(["sim", "--pty", "--firmware", "v1.0.0", "--pose"])
+        .arg(&file)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let stdout = child.stdout.take().unwrap();
+    let _child = Killed(child);
+    let mut path = String::new();
+    BufReader::new(stdout).read_line(&mut path).unwrap();
+    let mut port = serialport::new(path.trim(), 115_200)
+        .timeout(Duration::from_millis(50))
+        .open()
+        .unwrap();
+    port.write_all(&FORWARD_300).unwrap();
+    // 0.3 m/s for about a second: x near 0.3 m, y and yaw 0 (the board's own model).
+    std::thread::sleep(Duration::from_millis(1_000));
+    let text = std::fs::read_to_string(&file).unwrap();
+    let lines: Vec<Vec<f64>> = text
+        .lines()
+        .map(|l| l.split(' ').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert!(
+        lines.len() >= 50,
+        "a line every 10 ms: {} lines",
+        lines.len()
+    );
+    assert!(
+        lines.windows(2).all(|w| w[1][0] - w[0][0] == 10.0),
+        "10 ms apart"
+    );
+    let last = lines.last().unwrap();
+    assert!(
+        (0.15..0.4).contains(&last[1]) && last[2].abs() < 1e-6 && last[3].abs() < 1e-6,
+        "forward, nothing else: {last:?}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

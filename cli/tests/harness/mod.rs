@@ -49,10 +49,27 @@ struct Tap {
     times: Arc<Mutex<Vec<(Instant, usize)>>>,
     silent: Arc<AtomicBool>,
     drop_replies: Arc<AtomicU32>,
+    /// When the serving loop last read, and the times it did not for [`STALL`] or more: the
+    /// machine starved the simulated board (when each began, how long).
+    last_read: Option<Instant>,
+    stalls: Arc<Mutex<Vec<(Instant, Duration)>>>,
 }
+
+/// A gap this long between two turns of the serving loop (which reads every millisecond or
+/// so) is the machine starving the simulated board, not the board's behaviour.
+const STALL: Duration = Duration::from_millis(100);
 
 impl Read for Tap {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let now = Instant::now();
+        if let Some(last) = self.last_read.replace(now) {
+            if now.duration_since(last) >= STALL {
+                self.stalls
+                    .lock()
+                    .unwrap()
+                    .push((last, now.duration_since(last)));
+            }
+        }
         let n = self.inner.read(buf)?;
         let mut heard = self.heard.lock().unwrap();
         heard.extend_from_slice(&buf[..n]);
@@ -100,6 +117,7 @@ pub struct TestBoard<B = Board> {
     drop_replies: Arc<AtomicU32>,
     heard: Arc<Mutex<Vec<u8>>>,
     times: Arc<Mutex<Vec<(Instant, usize)>>>,
+    stalls: Arc<Mutex<Vec<(Instant, Duration)>>>,
     thread: Option<JoinHandle<io::Result<B>>>,
     _keep: TTYPort,
 }
@@ -129,7 +147,10 @@ impl<B: Simulated + Send + 'static> TestBoard<B> {
         let drop_replies = Arc::new(AtomicU32::new(0));
         let heard = Arc::new(Mutex::new(Vec::new()));
         let times = Arc::new(Mutex::new(Vec::new()));
+        let stalls = Arc::new(Mutex::new(Vec::new()));
         let tap = Tap {
+            last_read: None,
+            stalls: Arc::clone(&stalls),
             inner: board_end,
             heard: Arc::clone(&heard),
             times: Arc::clone(&times),
@@ -145,6 +166,7 @@ impl<B: Simulated + Send + 'static> TestBoard<B> {
             drop_replies,
             heard,
             times,
+            stalls,
             thread: Some(thread),
             _keep: path_end,
         }
@@ -173,6 +195,16 @@ impl<B: Simulated + Send + 'static> TestBoard<B> {
             .iter()
             .find(|(_, total)| *total >= len)
             .map(|(at, _)| *at)
+    }
+
+    /// Whether the machine starved the simulated board (its serving loop did not turn for 100 ms
+    /// or more) in a stretch that began before `at`.
+    pub fn stalled_before(&self, at: Instant) -> bool {
+        self.stalls
+            .lock()
+            .unwrap()
+            .iter()
+            .any(|(began, _)| *began < at)
     }
 
     /// `chassis --port PATH args`, run to its end.
