@@ -236,11 +236,15 @@ class Node:
     def signal(self, sig: int, timeout: float = 10.0) -> int:
         """Sends `sig` and returns the exit status (a negative number: killed by that signal)."""
         self.proc.send_signal(sig)
+        return self.wait(timeout)
+
+    def wait(self, timeout: float) -> int:
+        """The exit status, waiting up to `timeout` s (a negative number: killed by a signal)."""
         try:
             code = self.proc.wait(timeout)
         except subprocess.TimeoutExpired:
             self.kill()
-            raise RuntimeError(f"the node did not exit within {timeout} s of signal {sig}")
+            raise RuntimeError(f"the node did not exit within {timeout} s")
         self.err.join(2.0)
         return code
 

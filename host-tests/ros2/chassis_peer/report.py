@@ -5,7 +5,8 @@ drift: list[tuple[str, str, float, float, float]] = []
 run."""
 
 stops: list[tuple[str, str, float]] = []
-"""(generation, what stopped it, board ms from the cause to the last pose change)."""
+"""(generation, what stopped it, ms from the cause (the last `/cmd_vel` sent, the signal sent)
+to the simulator's pose first seen at its final value)."""
 
 
 def lines() -> list[str]:
@@ -19,7 +20,7 @@ def lines() -> list[str]:
         for gen, path, pos, head, length in sorted(drift):
             out.append(f"| {gen} | {path} | {length:.2f} m | {pos * 1000:.1f} mm | {head:.4f} rad |")
     if stops:
-        out += ["", "| firmware | cause | stopped after (board time) |", "|---|---|---:|"]
+        out += ["", "| firmware | cause | stopped after |", "|---|---|---:|"]
         for gen, cause, ms in sorted(stops):
             out.append(f"| {gen} | {cause} | {ms:.0f} ms |")
     return out
