@@ -1,8 +1,8 @@
 """Figures the end-to-end tests measure, printed in pytest's summary (`conftest.py`)."""
 
-drift: list[tuple[str, str, float, float, float]] = []
-"""(generation, path, position error m, heading error rad, path length m) for each odometry
-run."""
+drift: list[tuple[str, str, float, float, float, float]] = []
+"""(generation, path, position error m, heading error rad, path length m, position bound m) for
+each odometry run."""
 
 stops: list[tuple[str, str, float]] = []
 """(generation, what stopped it, ms from the cause (the last `/cmd_vel` sent, the signal sent)
@@ -14,11 +14,14 @@ def lines() -> list[str]:
     out = []
     if drift:
         out += [
-            "| firmware | path | length | position error | heading error |",
+            "| firmware | path | length | position error (bound) | heading error |",
             "|---|---|---:|---:|---:|",
         ]
-        for gen, path, pos, head, length in sorted(drift):
-            out.append(f"| {gen} | {path} | {length:.2f} m | {pos * 1000:.1f} mm | {head:.4f} rad |")
+        for gen, path, pos, head, length, bound in sorted(drift):
+            out.append(
+                f"| {gen} | {path} | {length:.2f} m | {pos * 1000:.1f} mm ({bound * 1000:.0f} mm) "
+                f"| {head:.4f} rad |"
+            )
     if stops:
         out += ["", "| firmware | cause | stopped after |", "|---|---|---:|"]
         for gen, cause, ms in sorted(stops):
