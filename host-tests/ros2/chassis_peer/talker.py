@@ -4,6 +4,7 @@ on their topics, `COUNT` rounds 50 ms apart once a reader has matched each topic
     python -m chassis_peer.talker COUNT
 """
 
+import os
 import sys
 import time
 
@@ -17,7 +18,7 @@ from .samples import BY_TOPIC
 
 def main() -> int:
     count = int(sys.argv[1]) if len(sys.argv) > 1 else 20
-    participant = DomainParticipant(0)
+    participant = DomainParticipant(int(os.environ.get("ROS_DOMAIN_ID", "0")))
     writers = {}
     for name, cls in PUBLISHED.items():
         topic = Topic(participant, dds_topic(name), cls, qos=ROS_QOS)
