@@ -143,7 +143,7 @@ fn await_first_frame<K: Spoken>(driver: &mut HostDriver<K>) {
 }
 
 /// After a stop went out: why the board is not known to have heard it (`None`: its frames
-/// are arriving), waiting up to [`FIRST_FRAME`] for the first one when none came yet.
+/// are arriving), waiting up to 150 ms for the first one when none came yet.
 pub fn unheard_after_stop<K: Spoken>(driver: &mut HostDriver<K>) -> Option<String> {
     await_first_frame(driver);
     unheard(driver)

@@ -46,11 +46,10 @@ pub fn imu(
             Quaternion { x, y, z, w },
             diagonal3(scale.orientation_variance),
         ),
-        None => {
-            let mut none = [0.0; 9];
-            none[0] = -1.0;
-            (Quaternion::IDENTITY, none)
-        }
+        None => (
+            Quaternion::IDENTITY,
+            [-1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        ),
     };
     Imu {
         header,

@@ -62,6 +62,11 @@ pub trait Io {
     fn finished(&mut self) -> bool {
         false
     }
+    /// Waits until a command may have come, `at_most` (the loop's turn: the board is read
+    /// after it).
+    fn wait(&mut self, at_most: Duration) {
+        std::thread::sleep(at_most);
+    }
 }
 
 /// How the loop ended.
@@ -147,7 +152,7 @@ pub fn run<K: Generation, I: Io>(
             break None;
         }
         node.step();
-        std::thread::sleep(Duration::from_millis(1));
+        node.io.wait(Duration::from_millis(1));
     };
     let stopped = stopping::stop(&mut node.driver);
     End { ending, stopped }

@@ -6,12 +6,14 @@ use crate::msg::{
     BatteryState, DiagnosticArray, Imu, Message, Odometry, TfMessage, Twist, TwistStamped,
 };
 use crate::node::{Command, Incoming, Io, Out};
+use ros2_client::dds::rustdds::mio1;
 use ros2_client::qos::{Durability, History};
 use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, Publisher,
     QosProfile, ROSTime, Subscription,
 };
 use serde::Serialize;
+use std::time::Duration;
 
 /// ROS 2's default QoS for topics: reliable, volatile, keep last 10.
 fn qos() -> QosProfile {
@@ -48,6 +50,9 @@ pub struct Ros {
     imu: Publisher<Imu>,
     battery: Publisher<BatteryState>,
     diagnostics: Publisher<DiagnosticArray>,
+    /// Wakes the loop when a `/cmd_vel` sample comes.
+    poll: mio1::Poll,
+    events: mio1::Events,
     /// Errors said once each.
     said: std::collections::HashSet<String>,
 }
@@ -74,6 +79,21 @@ fn publisher<M: Message + Serialize>(
         .map_err(|e| format!("publisher {name}: {e:?}"))
 }
 
+/// `/cmd_vel` of type `M`, its samples waking `poll`.
+fn subscribe<M: Message + serde::de::DeserializeOwned + 'static>(
+    node: &mut Node,
+    poll: &mio1::Poll,
+) -> Result<Subscription<M>, String> {
+    let topic = topic::<M>(node, "/", "cmd_vel")?;
+    let mut subscription = node
+        .create_subscription(&topic, Some(qos()))
+        .map_err(|e| format!("subscription cmd_vel: {e:?}"))?;
+    poll.registry()
+        .register(&mut subscription, mio1::Token(0), mio1::Interest::READABLE)
+        .map_err(|e| format!("cannot poll /cmd_vel: {e}"))?;
+    Ok(subscription)
+}
+
 impl Ros {
     /// The node `name` on domain `domain`, subscribed to `/cmd_vel` (`TwistStamped` when
     /// `stamped`), publishing `/odom`, `/tf` (when `tf`), `/imu/data_raw`, `/battery_state`
@@ -91,18 +111,11 @@ impl Ros {
                     .start_parameter_services(false),
             )
             .map_err(|e| format!("cannot create the node {name}: {e:?}"))?;
+        let poll = mio1::Poll::new().map_err(|e| format!("cannot poll: {e}"))?;
         let cmd_vel = if stamped {
-            let topic = topic::<TwistStamped>(&mut node, "/", "cmd_vel")?;
-            CmdVel::Stamped(
-                node.create_subscription(&topic, Some(qos()))
-                    .map_err(|e| format!("subscription cmd_vel: {e:?}"))?,
-            )
+            CmdVel::Stamped(subscribe(&mut node, &poll)?)
         } else {
-            let topic = topic::<Twist>(&mut node, "/", "cmd_vel")?;
-            CmdVel::Twist(
-                node.create_subscription(&topic, Some(qos()))
-                    .map_err(|e| format!("subscription cmd_vel: {e:?}"))?,
-            )
+            CmdVel::Twist(subscribe(&mut node, &poll)?)
         };
         let ros = Ros {
             odom: publisher(&mut node, "/", "odom")?,
@@ -115,6 +128,8 @@ impl Ros {
             battery: publisher(&mut node, "/", "battery_state")?,
             diagnostics: publisher(&mut node, "/", "diagnostics")?,
             cmd_vel,
+            poll,
+            events: mio1::Events::with_capacity(4),
             said: Default::default(),
             node,
         };
@@ -177,6 +192,13 @@ impl Io for Ros {
 
     fn now_ns(&self) -> i64 {
         self.node.time_now().to_nanos()
+    }
+
+    /// Wakes as soon as a `/cmd_vel` sample comes (a sample in the loop's next turn).
+    fn wait(&mut self, at_most: Duration) {
+        if self.poll.poll(&mut self.events, Some(at_most)).is_err() {
+            std::thread::sleep(at_most);
+        }
     }
 
     fn publish(&mut self, out: Out) {

@@ -105,3 +105,49 @@ fn the_v1_odometry_follows_the_board() {
         "v1.0.0 gives an orientation"
     );
 }
+
+#[test]
+fn no_transform_when_publish_tf_is_false_and_the_frames_are_the_parameters() {
+    let sim = Sim::v2020();
+    // Long enough for the 2020 board's battery frame (1 Hz).
+    let mut script = Script::new(steady(twist(0.1, 0.0, 0.0), 0, 200, 100), 1_200);
+    let params = Params {
+        publish_tf: false,
+        odom_frame: "odom_a".into(),
+        base_frame: "base_footprint".into(),
+        imu_frame: "imu_a".into(),
+        ..Params::default()
+    };
+    let driver = DriverCore::open(&sim.path).expect("the pty opens");
+    node::run(
+        driver,
+        &settings(&sim.path, params),
+        &mut script,
+        &mut Latency::default(),
+    );
+    let mut kinds = std::collections::BTreeSet::new();
+    for (_, out) in &script.published {
+        match out {
+            Out::Odom(m) => {
+                assert_eq!(m.header.frame_id, "odom_a");
+                assert_eq!(m.child_frame_id, "base_footprint");
+                kinds.insert("odom");
+            }
+            Out::Tf(_) => panic!("a transform published with publish_tf false"),
+            Out::Imu(m) => {
+                assert_eq!(m.header.frame_id, "imu_a");
+                kinds.insert("imu");
+            }
+            Out::Battery(_) => {
+                kinds.insert("battery");
+            }
+            Out::Diagnostics(_) => {
+                kinds.insert("diagnostics");
+            }
+        }
+    }
+    assert_eq!(
+        kinds.into_iter().collect::<Vec<_>>(),
+        ["battery", "diagnostics", "imu", "odom"]
+    );
+}

@@ -50,15 +50,12 @@ pub struct DiagnosticArray {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::msg::{Time, wire};
+    use crate::msg::{header, wire};
 
     #[test]
     fn diagnostic_array_bytes() {
         let array = DiagnosticArray {
-            header: Header {
-                stamp: Time { sec: 1, nanosec: 2 },
-                frame_id: String::new(),
-            },
+            header: header(1, 2, ""),
             status: vec![DiagnosticStatus {
                 level: DiagnosticStatus::WARN,
                 name: "c".into(),

@@ -156,7 +156,7 @@ pub struct TransformStamped {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::msg::{Time, wire};
+    use crate::msg::{header, wire};
 
     #[test]
     fn twist_bytes() {
@@ -191,10 +191,7 @@ mod tests {
         // Header: 8 bytes of time, length 2, "b" NUL: 14 bytes of payload; the first f64 goes
         // at offset 16, after 2 bytes of padding.
         let stamped = TwistStamped {
-            header: Header {
-                stamp: Time { sec: 1, nanosec: 0 },
-                frame_id: "b".into(),
-            },
+            header: header(1, 0, "b"),
             twist: Twist {
                 linear: Vector3 {
                     x: 2.0,

@@ -65,6 +65,15 @@ pub(crate) fn wire<T: serde::Serialize>(value: &T) -> Vec<u8> {
     out
 }
 
+/// A header stamped `sec` s and `nanosec` ns, in `frame`.
+#[cfg(test)]
+pub(crate) fn header(sec: i32, nanosec: u32, frame: &str) -> Header {
+    Header {
+        stamp: Time { sec, nanosec },
+        frame_id: frame.into(),
+    }
+}
+
 /// Little-endian bytes of the values given, for writing the expected bytes in the tests.
 #[cfg(test)]
 pub(crate) mod le {

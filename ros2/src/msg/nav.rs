@@ -21,7 +21,7 @@ pub struct Odometry {
 mod tests {
     use super::*;
     use crate::msg::le;
-    use crate::msg::{Point, Pose, Quaternion, Time, Twist, Vector3, wire};
+    use crate::msg::{Point, Pose, Quaternion, Twist, Vector3, header, wire};
 
     #[test]
     fn odometry_bytes_pad_after_the_strings() {
@@ -30,10 +30,7 @@ mod tests {
         let mut twist_cov = [0.0; 36];
         twist_cov[35] = 2.0;
         let odom = Odometry {
-            header: Header {
-                stamp: Time { sec: 3, nanosec: 0 },
-                frame_id: "odom".into(),
-            },
+            header: header(3, 0, "odom"),
             child_frame_id: "base_link".into(),
             pose: PoseWithCovariance {
                 pose: Pose {

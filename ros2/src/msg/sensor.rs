@@ -111,15 +111,12 @@ impl BatteryState {
 mod tests {
     use super::*;
     use crate::msg::le;
-    use crate::msg::{Time, wire};
+    use crate::msg::{header, wire};
 
     #[test]
     fn battery_state_bytes_with_its_sequences_and_strings() {
         let battery = BatteryState {
-            header: Header {
-                stamp: Time { sec: 0, nanosec: 0 },
-                frame_id: String::new(),
-            },
+            header: header(0, 0, ""),
             voltage: 12.5,
             temperature: f32::NAN,
             current: f32::NAN,
@@ -161,10 +158,7 @@ mod tests {
     #[test]
     fn imu_bytes_are_the_header_then_f64s_aligned() {
         let mut imu = Imu {
-            header: Header {
-                stamp: Time { sec: 0, nanosec: 0 },
-                frame_id: "imu".into(),
-            },
+            header: header(0, 0, "imu"),
             ..Imu::default()
         };
         imu.orientation_covariance[0] = -1.0;

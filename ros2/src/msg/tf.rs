@@ -14,16 +14,13 @@ pub struct TfMessage {
 mod tests {
     use super::*;
     use crate::msg::le;
-    use crate::msg::{Header, Quaternion, Time, Transform, Vector3, wire};
+    use crate::msg::{Quaternion, Transform, Vector3, header, wire};
 
     #[test]
     fn tf_message_bytes() {
         let message = TfMessage {
             transforms: vec![TransformStamped {
-                header: Header {
-                    stamp: Time { sec: 0, nanosec: 1 },
-                    frame_id: "odom".into(),
-                },
+                header: header(0, 1, "odom"),
                 child_frame_id: "b".into(),
                 transform: Transform {
                     translation: Vector3 {
