@@ -8,7 +8,11 @@ network namespace:
   as a share of one core, with the board's telemetry streaming and the commands going down;
 and the node binary's size, stripped.
 
-    python bench.py [--count N] [--rate HZ]     (cargo xtask ros2-bench [--count N] [--rate HZ])
+With `--segments`, instead: for each generation, the 1 m square of the tests driven with a rest
+after each side and each turn, and `/odom`'s error against the simulator's pose after each.
+
+    python bench.py [--count N] [--rate HZ] [--segments]
+    (cargo xtask ros2-bench [--count N] [--rate HZ] [--segments])
 """
 
 import argparse
@@ -22,7 +26,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from chassis_peer import dds, netns, procs
+from chassis_peer import dds, msgs, netns, procs
 
 STATS = re.compile(
     r"cmd_vel to wire: n=(\d+) p50=([\d.]+) ms p99=([\d.]+) ms max=([\d.]+) ms"
@@ -88,6 +92,32 @@ def run(firmware: str, count: int, rate: float) -> dict:
             sim.stop()
 
 
+def segments(firmware: str) -> None:
+    """The square with rests: `/odom`'s error after each side and each turn, printed."""
+    import math
+
+    from chassis_peer.rig import rig
+
+    print(f"{firmware}: /odom - simulator after each segment (x, y mm; yaw rad)")
+    with rig(firmware) as r:
+        r.settle(0.3)
+        for i in range(4):
+            for name, command, seconds in (
+                (f"side {i + 1}", (0.5, 0.0, 0.0), 2.0),
+                (f"turn {i + 1}", (0.0, 0.0, 1.0), math.pi / 2),
+            ):
+                r.peer.drive(*command, seconds=seconds)
+                r.settle(0.4)
+                truth = r.sim.pose()
+                odom = r.peer.latest("/odom").value.pose.pose
+                dyaw = msgs.yaw_of(odom.orientation) - truth.yaw
+                print(
+                    f"  {name}: {(odom.position.x - truth.x) * 1000:+6.1f} "
+                    f"{(odom.position.y - truth.y) * 1000:+6.1f} "
+                    f"{math.remainder(dyaw, 2 * math.pi):+.4f}"
+                )
+
+
 def stripped_size(binary: Path) -> tuple[int, int]:
     """The binary's size as built and stripped (`strip` on a copy)."""
     with tempfile.TemporaryDirectory() as tmp:
@@ -101,6 +131,9 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--count", type=int, default=1000, help="commands (default 1000)")
     parser.add_argument("--rate", type=float, default=100.0, help="commands a second (100)")
+    parser.add_argument(
+        "--segments", action="store_true", help="the square's odometry error segment by segment"
+    )
     args = parser.parse_args()
     if args.count < 1 or args.rate <= 0:
         parser.error("--count and --rate must be positive")
@@ -109,6 +142,10 @@ def main() -> int:
         print("bench: build chassis-ros2 and chassis first (cargo xtask ros2-bench)", file=sys.stderr)
         return 2
     netns.enter()
+    if args.segments:
+        for firmware in procs.GENERATIONS:
+            segments(firmware)
+        return 0
     rows = [run(firmware, args.count, args.rate) for firmware in procs.GENERATIONS]
     built, stripped = stripped_size(node_bin)
     print(f"{args.count} /cmd_vel at {args.rate:g} Hz per generation, in a private network namespace")
