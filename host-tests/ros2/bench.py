@@ -139,16 +139,26 @@ def main() -> int:
         parser.error("--count and --rate must be positive")
     node_bin, chassis_bin = procs.node_bin(), procs.chassis_bin()
     if node_bin is None or chassis_bin is None:
-        print("bench: build chassis-ros2 and chassis first (cargo xtask ros2-bench)", file=sys.stderr)
+        print(
+            "bench: build chassis-ros2 and chassis first (cargo xtask ros2-bench)",
+            file=sys.stderr,
+        )
         return 2
-    netns.enter()
+    try:
+        netns.enter()
+    except netns.NamespaceError as e:
+        print(f"bench: {e}", file=sys.stderr)
+        return 2
     if args.segments:
         for firmware in procs.GENERATIONS:
             segments(firmware)
         return 0
     rows = [run(firmware, args.count, args.rate) for firmware in procs.GENERATIONS]
     built, stripped = stripped_size(node_bin)
-    print(f"{args.count} /cmd_vel at {args.rate:g} Hz per generation, in a private network namespace")
+    print(
+        f"{args.count} /cmd_vel at {args.rate:g} Hz per generation, "
+        "in a private network namespace"
+    )
     print()
     print("| firmware | commands timed | p50 | p99 | max | node CPU (one core) |")
     print("|---|---:|---:|---:|---:|---:|")
@@ -158,7 +168,10 @@ def main() -> int:
             f"{r['max']:.3f} ms | {100 * r['cpu']:.1f} % over {r['seconds']:.1f} s |"
         )
     print()
-    print(f"chassis-ros2: {stripped / 1e6:.2f} MB stripped ({built / 1e6:.1f} MB as built, with debug info)")
+    print(
+        f"chassis-ros2: {stripped / 1e6:.2f} MB stripped "
+        f"({built / 1e6:.1f} MB as built, with debug info)"
+    )
     return 0
 
 

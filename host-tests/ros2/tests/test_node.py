@@ -142,10 +142,13 @@ def test_odometry_ends_near_the_true_pose(firmware, path):
         tf = r.peer.wait_for("/tf", 2.0, since=stopped_at + 0.4)
         assert tf is not None, "no /tf after the run"
         (t,) = [t for t in tf.value.transforms if t.child_frame_id == "base_link"]
-        assert t.header.frame_id == "odom"
-        tf_err = math.hypot(t.transform.translation.x - truth.x, t.transform.translation.y - truth.y)
+        assert t.header.frame_id == "odom", t
+        tf_err = math.hypot(
+            t.transform.translation.x - truth.x, t.transform.translation.y - truth.y
+        )
         assert tf_err <= bound, f"/tf off by {tf_err:.4f} m; {t}"
-        assert abs(wrap(msgs.yaw_of(t.transform.rotation) - truth.yaw)) <= HEADING_BOUND
+        tf_yaw = msgs.yaw_of(t.transform.rotation)
+        assert abs(wrap(tf_yaw - truth.yaw)) <= HEADING_BOUND, f"/tf yaw {tf_yaw}; {seen}"
 
 
 def _key(pose: procs.Pose) -> tuple:
