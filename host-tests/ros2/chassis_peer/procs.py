@@ -202,15 +202,31 @@ class Sim:
 
 
 class Node:
-    """`chassis-ros2 --port PTY --firmware F --params FILE [extra…]`, started and awaited until
-    it prints `ready:`."""
+    """`chassis-ros2 --port PTY --firmware F --params FILE [extra…]` (or the same through
+    `chassis ros2` with `via_cli`), started and awaited until it prints `ready:`."""
 
-    def __init__(self, sim: Sim, params_file: Path, extra: tuple = (), ready_timeout: float = 20.0):
+    def __init__(
+        self,
+        sim: Sim,
+        params_file: Path,
+        extra: tuple = (),
+        ready_timeout: float = 20.0,
+        via_cli: bool = False,
+    ):
         exe = node_bin()
         if exe is None:
             raise FileNotFoundError("the node chassis-ros2 is not built")
+        env = dict(os.environ)
+        head = [str(exe)]
+        if via_cli:
+            # `chassis ros2 ARGS…`: the CLI runs the node found beside it or on PATH.
+            cli = chassis_bin()
+            if cli is None:
+                raise FileNotFoundError("the chassis CLI is not built")
+            head = [str(cli), "ros2"]
+            env["PATH"] = f"{exe.parent}{os.pathsep}{env.get('PATH', '')}"
         args = [
-            str(exe),
+            *head,
             "--port",
             sim.pty,
             "--firmware",
@@ -221,7 +237,11 @@ class Node:
         ]
         self.args = args
         self.proc = subprocess.Popen(
-            args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL
+            args,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            stdin=subprocess.DEVNULL,
+            env=env,
         )
         self.out = _Lines(self.proc.stdout)
         self.err = _Lines(self.proc.stderr)

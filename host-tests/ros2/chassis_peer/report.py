@@ -23,7 +23,8 @@ def lines() -> list[str]:
                 f"| {head:.4f} rad |"
             )
     if stops:
-        out += ["", "| firmware | cause | stopped after |", "|---|---|---:|"]
+        out += [""] if out else []
+        out += ["| firmware | cause | stopped after |", "|---|---|---:|"]
         for gen, cause, ms in sorted(stops):
             out.append(f"| {gen} | {cause} | {ms:.0f} ms |")
     return out

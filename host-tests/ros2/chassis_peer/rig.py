@@ -28,11 +28,15 @@ class Rig:
 
 @contextlib.contextmanager
 def rig(
-    firmware: str, extra: tuple = (), timeout: float = 0.5, stamped: bool = False
+    firmware: str,
+    extra: tuple = (),
+    timeout: float = 0.5,
+    stamped: bool = False,
+    via_cli: bool = False,
 ) -> Iterator[Rig]:
     """Starts the simulator of `firmware`, the node on it (with `extra` arguments and
-    `cmd_vel_timeout` = `timeout` in its parameters file) and a peer matched with it; stops all
-    three at the end."""
+    `cmd_vel_timeout` = `timeout` in its parameters file; through `chassis ros2` with
+    `via_cli`) and a peer matched with it; stops all three at the end."""
     with tempfile.TemporaryDirectory(prefix="chassis-ros2-") as tmp:
         directory = Path(tmp)
         params = procs.params(firmware, directory, timeout)
@@ -40,7 +44,7 @@ def rig(
         node: Optional[procs.Node] = None
         peer: Optional[dds.Peer] = None
         try:
-            node = procs.Node(sim, params, extra)
+            node = procs.Node(sim, params, extra, via_cli=via_cli)
             peer = dds.Peer(stamped=stamped)
             if not peer.wait_matched(10.0, ["/odom"]):
                 raise RuntimeError(

@@ -214,7 +214,18 @@ def test_signal_stops_the_chassis(firmware, sig, status):
     """A signal to the node while `/cmd_vel` keeps coming stops the chassis within STOP_SLACK of
     the signal (the cmd_vel timeout is 5 s, so it is the signal that stops it) and the node
     exits with 128 + the signal's number."""
-    with rig(firmware, timeout=5.0) as r:
+    _signal_stops(firmware, sig, status, via_cli=False)
+
+
+@pytest.mark.parametrize("firmware", GENERATIONS)
+def test_chassis_ros2_runs_the_node(firmware):
+    """`chassis ros2 ARGS…` runs the same node: it drives the chassis, and SIGTERM to the
+    `chassis` process stops it and ends it with the node's status, 143."""
+    _signal_stops(firmware, signal.SIGTERM, 143, via_cli=True)
+
+
+def _signal_stops(firmware: str, sig: int, status: int, via_cli: bool) -> None:
+    with rig(firmware, timeout=5.0, via_cli=via_cli) as r:
         driver = Repeater(r.peer, SPEED, 0.0, 0.0)
         time.sleep(0.8)
         last = _moving(r, firmware)
@@ -223,9 +234,11 @@ def test_signal_stops_the_chassis(firmware, sig, status):
         after = _stopped_after(r, signalled, last, f"{firmware}, node stderr:\n{r.node.stderr()}")
         code = r.node.wait(5.0)
         driver.stop()
-        report.stops.append((firmware, signal.Signals(sig).name, after * 1000))
+        name = signal.Signals(sig).name + (" to `chassis ros2`" if via_cli else "")
+        if not via_cli:
+            report.stops.append((firmware, name, after * 1000))
         assert code == status, f"exit status {code}, want {status}; stderr:\n{r.node.stderr()}"
-        assert after <= STOP_SLACK, f"stopped {after:.3f} s after {signal.Signals(sig).name}"
+        assert after <= STOP_SLACK, f"stopped {after:.3f} s after {name}"
 
 
 @pytest.mark.parametrize("firmware", GENERATIONS)
