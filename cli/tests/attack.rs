@@ -433,6 +433,9 @@ fn run(index: usize, ending: Ending, moment_ms: u64, dir: &std::path::Path) -> O
     // which may already have been failing on it when the ending came (its words not written
     // yet): its exit and words are its own, what became of the chassis is judged all the same.
     ended_first |= !refused && board.stalled_before(ended_at);
+    // Starved after the ending, the board may not confirm the stop in time: a command that
+    // says so tells the truth.
+    let starved = board.stalled_before(Instant::now());
     let heard = board.heard();
     let heard_len = heard.len();
     // When the last stop arrived (the board still serving keeps the times).
@@ -501,7 +504,10 @@ fn run(index: usize, ending: Ending, moment_ms: u64, dir: &std::path::Path) -> O
         {
             true
         }
-        _ if verdict.moved => said_clean.contains("the chassis was stopped"),
+        _ if verdict.moved => {
+            said_clean.contains("the chassis was stopped")
+                || (starved && said_clean.contains("the stop was sent but not confirmed"))
+        }
         _ => {
             said_clean.contains("the chassis was stopped")
                 || said_clean.contains("not moved")
