@@ -11,6 +11,8 @@
 //! | `fuzz [SECONDS]` | only the fuzz targets, each for SECONDS (default 30), exploring: random seed, corpora kept |
 //! | `sweep [--seed N] [--v1]` | the full noise sweep of the downlink parser over every stream model (a few minutes; not part of `test`), then the v1.0.0 board → master parser's (`--v1`: only that one, about 15 s) |
 //! | `bench [--runs N]` | the parser beside its peers (sbus-rs, uf-crsf, crsf) and the v1.0.0 parser in one run (or N: the median of each run's ratios): a table with the ratios (not part of `test`, which only builds it) |
+//! | `ros2` | the ROS 2 node (`chassis-ros2`) and the CLI built, then checked from outside by an independent DDS peer (Python, Cyclone DDS, `host-tests/ros2/`) in a private network namespace, against the simulated board of each generation: motion, odometry drift, the `/cmd_vel` timeout, the stop on signals, every message's bytes against an independent CDR encoder (part of `test`; needs root for the namespace) |
+//! | `ros2-bench [ARGS]` | the node's figures: `/cmd_vel` to the wire p50/p99, CPU at the link's full rate, the stripped binary's size (not part of `test`) |
 //! | `python` | the Python package built into a virtual environment (`target/python-venv`) as `pip install ./python` builds it, its pytest suite and `mypy --strict` on its examples (part of `test`) |
 //! | `host-demo` | frames built and a noisy board stream parsed, on the host |
 //! | `qemu ELF [--scenario NAME]` | boots a firmware in QEMU against the simulated chassis (the QEMU board's cargo runner) |
@@ -19,7 +21,7 @@
 //! root, defmt-print, the nightly toolchain, cargo-fuzz, cargo-public-api and cargo-hack) before it runs, so
 //! a fresh machine with rustup and cargo needs nothing else.
 //!
-//! A module per family of tasks: [`mod@test`], [`package`], [`public_api`], [`python`], [`mod@bench`]
+//! A module per family of tasks: [`mod@test`], [`package`], [`public_api`], [`python`], [`ros2`], [`mod@bench`]
 //! (and `sweep`), [`fuzz`], [`firmware`] (`demo`, `qemu`, `size`, `icount`, the firmware half
 //! of `test`); [`cmd`] runs the tools they drive, [`tools`] installs them.
 
@@ -30,6 +32,7 @@ mod fuzz;
 mod package;
 mod public_api;
 mod python;
+mod ros2;
 mod test;
 mod tools;
 
@@ -46,6 +49,8 @@ fn main() -> ExitCode {
         "qemu" => firmware::qemu(&args),
         "test" => test::test(),
         "python" => python::python(),
+        "ros2" => ros2::ros2(),
+        "ros2-bench" => ros2::ros2_bench(&args),
         "package" => package::package(),
         "public-api" => public_api::public_api(&args),
         "sweep" => bench::sweep(&args),
@@ -61,7 +66,7 @@ fn main() -> ExitCode {
         }
         _ => {
             eprintln!(
-                "usage: cargo xtask <demo | test | python | package | public-api [--bless] | size | \
+                "usage: cargo xtask <demo | test | python | ros2 | ros2-bench | package | public-api [--bless] | size | \
                  icount | sweep [--seed N] [--v1] | bench [--runs N] | fuzz [SECONDS] | host-demo | \
                  qemu FIRMWARE.elf>"
             );

@@ -3,14 +3,11 @@
 use crate::cmd::{check, run, workspace_root};
 use std::process::Command;
 
-/// The Python package: built as a user builds it (`pip install ./python`, maturin as the build
-/// backend) into a virtual environment under `target/`, then its tests (pytest, against the
-/// simulated boards on pseudo-terminals) and its examples' types (`mypy --strict`).
-pub(crate) fn python() -> Result<(), String> {
-    let root = workspace_root()?;
-    let venv = root.join("target").join("python-venv");
-    let bin = venv.join("bin");
-    let python = bin.join("python");
+/// The Python of the virtual environment `target/<name>` (made with `$PYTHON`, else `python3`,
+/// if it is not there yet), its pip upgraded.
+pub(crate) fn venv_python(name: &str) -> Result<String, String> {
+    let venv = workspace_root()?.join("target").join(name);
+    let python = venv.join("bin").join("python");
     if !python.is_file() {
         let venv = venv.to_string_lossy();
         run(
@@ -19,13 +16,23 @@ pub(crate) fn python() -> Result<(), String> {
         )?;
     }
     let python = python.to_string_lossy().into_owned();
-    let package = root.join("python");
-    let package = package.to_string_lossy();
-    let with_tests = format!("{package}[test]");
     run(
         &python,
         &["-m", "pip", "install", "--quiet", "--upgrade", "pip"],
     )?;
+    Ok(python)
+}
+
+/// The Python package: built as a user builds it (`pip install ./python`, maturin as the build
+/// backend) into a virtual environment under `target/`, then its tests (pytest, against the
+/// simulated boards on pseudo-terminals) and its examples' types (`mypy --strict`).
+pub(crate) fn python() -> Result<(), String> {
+    let root = workspace_root()?;
+    let venv = root.join("target").join("python-venv");
+    let python = venv_python("python-venv")?;
+    let package = root.join("python");
+    let package = package.to_string_lossy();
+    let with_tests = format!("{package}[test]");
     run(
         &python,
         &[

@@ -6,7 +6,7 @@
 use crate::cmd::{cargo, cargo_program, run, run_with, workspace_root};
 use crate::fuzz::{FuzzRun, fuzz};
 use crate::tools::{install_cargo_tool, install_targets, rustup_list};
-use crate::{firmware, package, public_api, python};
+use crate::{firmware, package, public_api, python, ros2};
 
 /// Thumb targets the protocol crate must build for: Cortex-M0+ and Cortex-M4F.
 const THUMB_TARGETS: [&str; 2] = ["thumbv6m-none-eabi", "thumbv7em-none-eabihf"];
@@ -61,6 +61,7 @@ pub(crate) fn test() -> Result<(), String> {
     ])?;
     msrv()?;
     python::python()?;
+    ros2::ros2()?;
     firmware::test()?;
     fuzz(FuzzRun::Repeatable)
 }

@@ -1,7 +1,7 @@
 //! Installing what the tasks need when it is missing: rustup targets and toolchains, and cargo's
 //! own tools (cargo-fuzz, and cargo-hack and cargo-public-api at pinned versions).
 
-use crate::cmd::{cargo, run};
+use crate::cmd::{cargo, run, run_with};
 use std::process::Command;
 
 /// Adds the rustup targets that are not installed yet.
@@ -74,4 +74,40 @@ pub(crate) fn install_cargo_tool(
         args.extend(["--version", version]);
     }
     cargo(&args)
+}
+
+/// Whether `program <version_flag>` runs.
+pub(crate) fn installed(program: &str, version_flag: &str) -> bool {
+    Command::new(program)
+        .arg(version_flag)
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// `program` present (`program <version_flag>` runs), or the Debian package `package` installed
+/// through apt when running as root; else an error that says how (`how`).
+pub(crate) fn ensure_apt(
+    program: &str,
+    version_flag: &str,
+    package: &str,
+    how: &str,
+) -> Result<(), String> {
+    if installed(program, version_flag) {
+        return Ok(());
+    }
+    let root = Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
+    if !root {
+        return Err(format!(
+            "{program} is missing: install it ({how}) and run this again"
+        ));
+    }
+    run_with("apt-get", &["update", "-qq"], &[])?;
+    run_with(
+        "apt-get",
+        &["install", "-y", "-qq", package],
+        &[("DEBIAN_FRONTEND", "noninteractive")],
+    )
 }

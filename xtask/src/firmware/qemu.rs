@@ -2,47 +2,25 @@
 //! `cargo xtask qemu ELF` (the QEMU board's cargo runner), and what they need installed.
 
 use super::{BOARDS, M4, build_board, elf};
-use crate::cmd::{cargo, cargo_program, check, run_with, workspace_root};
-use crate::tools::install_targets;
+use crate::cmd::{cargo, cargo_program, check, workspace_root};
+use crate::tools::{ensure_apt, install_targets, installed};
 use std::path::Path;
 use std::process::Command;
 use std::time::Instant;
 
-/// Whether `program --version` runs.
-fn installed(program: &str) -> bool {
-    Command::new(program)
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success())
-}
-
 /// `qemu-system-arm` present, or installed through apt when running as root.
 pub(super) fn ensure_qemu() -> Result<(), String> {
-    if installed("qemu-system-arm") {
-        return Ok(());
-    }
-    let root = Command::new("id")
-        .arg("-u")
-        .output()
-        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
-    if !root {
-        return Err(
-            "qemu-system-arm is missing: install it (Debian/Ubuntu: `sudo apt-get install -y \
-             qemu-system-arm`; macOS: `brew install qemu`) and run this again"
-                .to_string(),
-        );
-    }
-    run_with("apt-get", &["update", "-qq"], &[])?;
-    run_with(
-        "apt-get",
-        &["install", "-y", "-qq", "qemu-system-arm"],
-        &[("DEBIAN_FRONTEND", "noninteractive")],
+    ensure_apt(
+        "qemu-system-arm",
+        "--version",
+        "qemu-system-arm",
+        "Debian/Ubuntu: `sudo apt-get install -y qemu-system-arm`; macOS: `brew install qemu`",
     )
 }
 
 /// `defmt-print` present, or installed with cargo.
 pub(super) fn ensure_defmt_print() -> Result<(), String> {
-    if installed("defmt-print") {
+    if installed("defmt-print", "--version") {
         return Ok(());
     }
     cargo(&["install", "--locked", "defmt-print"])
