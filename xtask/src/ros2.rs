@@ -10,10 +10,11 @@ use std::process::Command;
 /// The virtual environment of the peer, under `target/`.
 const VENV: &str = "ros2-venv";
 
-/// `cargo xtask ros2`: the node and the CLI built (release), the peer's packages installed, its
-/// pytest suite run (it makes its own network namespace as it starts).
+/// `cargo xtask ros2`: the node and the CLI built (the dev profile: `cargo test --workspace`
+/// has built them already, and every bound of the suite holds with them), the peer's packages
+/// installed, its pytest suite run (it makes its own network namespace as it starts).
 pub(crate) fn ros2() -> Result<(), String> {
-    let peer = prepare()?;
+    let peer = prepare(Profile::Dev)?;
     let tests = peer.dir.join("tests");
     run_with(
         &peer.python,
@@ -26,7 +27,7 @@ pub(crate) fn ros2() -> Result<(), String> {
 /// link's full rate, the stripped binary's size), printed as a table; `ARGS` go to the script
 /// (`--help`).
 pub(crate) fn ros2_bench(args: &[String]) -> Result<(), String> {
-    let peer = prepare()?;
+    let peer = prepare(Profile::Release)?;
     let script = peer.dir.join("bench.py");
     let script = script.to_string_lossy();
     let mut all = vec![script.as_ref()];
@@ -52,9 +53,19 @@ impl Peer {
     }
 }
 
+/// The build profile of the node and the CLI the peer runs.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Profile {
+    /// The tests'.
+    Dev,
+    /// The figures'.
+    Release,
+}
+
 /// Checks that a private network namespace can be made, installs `ip` if missing, builds the
-/// node and the CLI, and installs the peer's pinned packages into `target/ros2-venv`.
-fn prepare() -> Result<Peer, String> {
+/// node and the CLI in `profile`, and installs the peer's pinned packages into
+/// `target/ros2-venv`.
+fn prepare(profile: Profile) -> Result<Peer, String> {
     namespace_permitted()?;
     ensure_apt(
         "ip",
@@ -62,14 +73,11 @@ fn prepare() -> Result<Peer, String> {
         "iproute2",
         "Debian/Ubuntu: `sudo apt-get install -y iproute2`",
     )?;
-    cargo(&[
-        "build",
-        "--release",
-        "-p",
-        "chassis-ros2",
-        "-p",
-        "chassis-cli",
-    ])?;
+    let mut build = vec!["build", "-p", "chassis-ros2", "-p", "chassis-cli"];
+    if profile == Profile::Release {
+        build.push("--release");
+    }
+    cargo(&build)?;
     let dir = workspace_root()?.join("host-tests").join("ros2");
     let python = venv_python(VENV)?;
     let requirements = dir.join("requirements.txt");
@@ -85,12 +93,15 @@ fn prepare() -> Result<Peer, String> {
         ],
         &[],
     )?;
-    let release = target_dir()?.join("release");
+    let built = target_dir()?.join(match profile {
+        Profile::Dev => "debug",
+        Profile::Release => "release",
+    });
     Ok(Peer {
         python,
         dir,
-        chassis: release.join("chassis").to_string_lossy().into_owned(),
-        node: release.join("chassis-ros2").to_string_lossy().into_owned(),
+        chassis: built.join("chassis").to_string_lossy().into_owned(),
+        node: built.join("chassis-ros2").to_string_lossy().into_owned(),
     })
 }
 
