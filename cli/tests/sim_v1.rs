@@ -27,19 +27,27 @@ impl Drop for Killed {
     }
 }
 
-#[test]
-fn sim_pty_firmware_v1_answers_a_readback_among_its_telemetry() {
+/// `chassis sim --pty --firmware v1.0.0` with `extra` arguments: the child (killed when
+/// dropped) and the path it printed first.
+fn sim_v1(extra: &[&std::ffi::OsStr]) -> (Killed, String) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_chassis"))
         .args(["sim", "--pty", "--firmware", "v1.0.0"])
+        .args(extra)
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
     let stdout = child.stdout.take().unwrap();
-    let _child = Killed(child);
+    let child = Killed(child);
     let mut path = String::new();
     BufReader::new(stdout).read_line(&mut path).unwrap();
-    let path = path.trim();
+    (child, path.trim().to_string())
+}
+
+#[test]
+fn sim_pty_firmware_v1_answers_a_readback_among_its_telemetry() {
+    let (_child, path) = sim_v1(&[]);
+    let path = path.as_str();
     assert!(
         path.starts_with("/dev/"),
         "the first line is the path: {path:?}"
@@ -115,18 +123,8 @@ fn sim_pose_writes_the_true_pose_as_the_chassis_drives() {
     let dir = std::env::temp_dir().join(format!("chassis-sim-pose-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("pose.txt");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_chassis"))
-        .args(["sim", "--pty", "--firmware", "v1.0.0", "--pose"])
-        .arg(&file)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let stdout = child.stdout.take().unwrap();
-    let _child = Killed(child);
-    let mut path = String::new();
-    BufReader::new(stdout).read_line(&mut path).unwrap();
-    let mut port = serialport::new(path.trim(), 115_200)
+    let (_child, path) = sim_v1(&["--pose".as_ref(), file.as_os_str()]);
+    let mut port = serialport::new(path, 115_200)
         .timeout(Duration::from_millis(50))
         .open()
         .unwrap();

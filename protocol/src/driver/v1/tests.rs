@@ -44,6 +44,21 @@ fn telemetry() -> [u8; 32] {
     .encode()
 }
 
+/// Ticks the core a millisecond at a time after `from` (until 2 s), a geometry readback asked
+/// for again whenever none runs if `reading`: when the forced stop went, if it did.
+fn forced_stop_after(core: &mut DriverCore, from: u64, reading: bool) -> Option<u64> {
+    for now in from + 1..2_000 {
+        if reading && !core.busy() {
+            core.start(Request::Read(Readback::Geometry)).unwrap();
+        }
+        core.tick(now);
+        if out(core, now).contains(&FORCED_STOP.to_vec()) {
+            return Some(now);
+        }
+    }
+    None
+}
+
 fn driving(now: u64) -> DriverCore {
     let mut core = DriverCore::new(Config::DEFAULT);
     core.velocity(BodyVelocity::new(0, 300, 0), now).unwrap();
@@ -82,18 +97,7 @@ fn readbacks_a_silent_board_leaves_unanswered_never_hold_the_failsafe_off() {
     // thread's loop): the forced stop still comes 300 ms after the last frame heard.
     let mut core = driving(0);
     hear(&mut core, &telemetry(), 10);
-    let mut stopped = None;
-    let mut now = 10;
-    while now < 2_000 && stopped.is_none() {
-        if !core.busy() {
-            core.start(Request::Read(Readback::Geometry)).unwrap();
-        }
-        now += 1;
-        core.tick(now);
-        if out(&mut core, now).contains(&FORCED_STOP.to_vec()) {
-            stopped = Some(now);
-        }
-    }
+    let stopped = forced_stop_after(&mut core, 10, true);
     assert_eq!(
         stopped,
         Some(311),
@@ -112,15 +116,7 @@ fn a_frame_cut_short_after_a_readback_never_holds_the_failsafe_off() {
     core.start(Request::Read(Readback::Geometry)).unwrap();
     assert_eq!(out(&mut core, 20), vec![READ_GEOMETRY.to_vec()]);
     hear(&mut core, &telemetry()[..12], 25);
-    let mut stopped = None;
-    let mut now = 25;
-    while now < 2_000 && stopped.is_none() {
-        now += 1;
-        core.tick(now);
-        if out(&mut core, now).contains(&FORCED_STOP.to_vec()) {
-            stopped = Some(now);
-        }
-    }
+    let stopped = forced_stop_after(&mut core, 25, false);
     assert_eq!(
         stopped,
         Some(311),
