@@ -1,63 +1,57 @@
-//! What a candidate is ([`Class`]): its count against the line's, and the suspicions a frame
-//! can raise (inside a frame rejected on a boundary, a header for its count byte, a frame
-//! nested in it, in a reply's value); and where it starts ([`Start`]).
+//! The facts about a candidate ([`Facts`]): its count against the line's, and the suspicions a
+//! frame can raise (inside a frame rejected on a boundary, a header for its count byte, a frame
+//! nested in it, in a reply's value); and where it starts ([`Start`]). Nothing here decides.
 
 use super::counts::Rel;
-use super::rules::{Class, Start};
+use super::rules::{Facts, Seen, Start};
 use super::{DownlinkParser, Lock};
 use crate::telemetry::{self, Downlink, Kind, Stream};
 
 impl DownlinkParser {
-    /// What the candidate `frame`, starting `at` bytes into the window, is.
-    pub(super) fn class(&self, frame: &Downlink, at: usize) -> Class {
-        match frame {
-            // (Inside a frame rejected on a boundary, the awaited code is no evidence either:
-            // row 12.)
-            Downlink::Reply(reply)
-                if self.expect == Some(reply.code)
-                    && !(self.lock == Lock::Hunting && self.in_shadow() && at == 0) =>
-            {
-                Class::Expected {
+    /// The facts about the candidate `frame` at the front of the window that the table
+    /// ([`rules::decide`](super::rules::decide)) reads. The suspicions only hunting reads are
+    /// looked for only while hunting.
+    pub(super) fn facts(&self, frame: &Downlink) -> Facts {
+        let hunting = self.lock == Lock::Hunting;
+        let mut facts = Facts {
+            seen: Seen::Telemetry(Rel::Unknown),
+            shadow: hunting && self.in_shadow(),
+            other_fits: false,
+            cut: false,
+            nested: false,
+        };
+        match (frame, frame.kind(), frame.seq()) {
+            (Downlink::Reply(reply), ..) => {
+                facts.seen = Seen::Reply {
+                    awaited: self.expect == Some(reply.code),
                     clean: !holds_a_frame_start(reply.encode().get(2..).unwrap_or(&[])),
+                };
+            }
+            (_, Kind::Telemetry(stream), Some(seq)) => {
+                let rel = self.counts.rel(stream, seq, 0);
+                facts.seen = Seen::Telemetry(rel);
+                facts.cut = self.ends_with_a_header(frame, 0);
+                if hunting {
+                    facts.nested = self.nested(frame, rel);
+                    facts.other_fits = matches!(rel, Rel::Continues | Rel::Near)
+                        && self.other_stream_fits(stream, seq, 0);
                 }
             }
-            Downlink::Reply(_) => Class::Unexpected,
-            _ if self.lock == Lock::Hunting
-                && at == 0
-                && (self.in_shadow()
-                    && (!self.near(frame) && self.nests_a_frame(frame, &[0])
-                        || self.overlaps_the_rejected_frames_next(frame)
-                        || self.is_the_rejected_frames_tail(frame))
-                    || self.nests_a_frame(frame, &[1, -1])
-                    || self.in_a_replys_value(frame)
-                    || self.inside_a_headless_frame(frame)) =>
-            {
-                Class::Nested
-            }
-            _ => match (frame.kind(), frame.seq()) {
-                (Kind::Telemetry(stream), Some(seq)) => {
-                    let cut = self.ends_with_a_header(frame, at);
-                    match self.counts.rel(stream, seq, at) {
-                        // (Inside a frame rejected on a boundary, a continuing count is no
-                        // evidence, nor one that is a header's second byte: row 9.)
-                        Rel::Continues | Rel::Near
-                            if self.lock == Lock::Hunting
-                                && (self.in_shadow() && at == 0
-                                    || self.other_stream_fits(stream, seq, at)
-                                    || cut) =>
-                        {
-                            Class::Ambiguous
-                        }
-                        Rel::Continues => Class::Continues,
-                        Rel::Near => Class::Near,
-                        Rel::Unknown => Class::First,
-                        Rel::Far if cut => Class::Cut,
-                        Rel::Far => Class::Far,
-                    }
-                }
-                _ => Class::Unexpected,
-            },
+            _ => {}
         }
+        facts
+    }
+
+    /// Row 14's suspicion about the telemetry candidate `frame` (count `rel`) at the front of
+    /// the window, while hunting: its bytes hold a real frame it cannot be.
+    fn nested(&self, frame: &Downlink, rel: Rel) -> bool {
+        self.in_shadow()
+            && (rel != Rel::Near && self.nests_a_frame(frame, &[0])
+                || self.overlaps_the_rejected_frames_next(frame)
+                || self.is_the_rejected_frames_tail(frame))
+            || self.nests_a_frame(frame, &[1, -1])
+            || self.in_a_replys_value(frame)
+            || self.inside_a_headless_frame(frame)
     }
 
     /// Inside a frame rejected on a boundary: whether a telemetry header lies inside the
@@ -185,14 +179,6 @@ impl DownlinkParser {
                 && before(back.saturating_add(1)) != Some(sync)
                 && matches!(self.counts.rel(*outer, seq, 0), Rel::Continues | Rel::Near)
         })
-    }
-
-    /// Whether the telemetry `frame` at the front of the window has a near count.
-    pub(super) fn near(&self, frame: &Downlink) -> bool {
-        match (frame.kind(), frame.seq()) {
-            (Kind::Telemetry(stream), Some(seq)) => self.counts.rel(stream, seq, 0) == Rel::Near,
-            _ => false,
-        }
     }
 
     /// Whether `seq` would continue (or be near) a stream other than `stream`; not counting, for

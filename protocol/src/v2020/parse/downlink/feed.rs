@@ -77,8 +77,8 @@ impl DownlinkParser {
                     return None;
                 }
                 Verdict::Reject => self.reject(),
-                Verdict::Accept(frame, len, class) => {
-                    self.accept(&frame, len, class);
+                Verdict::Accept(frame, len, seen) => {
+                    self.accept(&frame, len, seen);
                     // Another frame can be ready at once only if bytes are left.
                     self.drain = self.buf.len() > 0;
                     return Some(frame);

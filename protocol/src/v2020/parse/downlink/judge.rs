@@ -1,10 +1,10 @@
-//! Judging the candidate at the front of the window: what the rules ([`rules::need`]) ask of
+//! Judging the candidate at the front of the window: what the table ([`rules::decide`]) asks of
 //! it, and the chain of frames after it that may vouch for it ([`Walk`]).
 
 use super::class::stream_of_second;
 use super::counts::{Counts, Rel};
-use super::rules::{self, Chain, Class, Need};
-use super::{DownlinkParser, IN_STEP, Lock, MAX_GAP, WINDOW};
+use super::rules::{self, Chain, Need, Seen, Walk as Rule};
+use super::{DownlinkParser, IN_STEP, Lock, WINDOW};
 use crate::telemetry::{self, Downlink, Kind, Stream};
 use core::ops::ControlFlow::{self, Break, Continue};
 
@@ -15,8 +15,8 @@ pub(super) enum Verdict {
     NeedMore(usize),
     /// The first byte starts no frame: drop it.
     Reject,
-    /// A frame of this length, and what it was judged to be.
-    Accept(Downlink, usize, Class),
+    /// A frame of this length, and what it was seen to be.
+    Accept(Downlink, usize, Seen),
 }
 
 /// What a step of the walk decided: `Break` with the chain's answer (`Err(n)`: not before `n`
@@ -29,15 +29,13 @@ type Step<T = ()> = ControlFlow<Result<bool, usize>, T>;
 struct Walk<'a> {
     parser: &'a DownlinkParser,
     buf: &'a [u8],
-    class: Class,
+    rule: Rule,
     chain: Chain,
     quiet: bool,
     /// The counts as the chain so far leaves them (the candidate's own taken).
     counts: Counts,
     /// The candidate's stream, if it is telemetry.
     own: Option<Stream>,
-    /// Whether a quiet line right after the candidate vouches for it.
-    quiet_vouches: bool,
     /// Where the next frame should start, and how many junk bytes may come first.
     pos: usize,
     gap: usize,
@@ -55,7 +53,7 @@ impl<'a> Walk<'a> {
         buf: &'a [u8],
         frame: &Downlink,
         len: usize,
-        (class, chain): (Class, Chain),
+        rule: Rule,
         quiet: bool,
     ) -> Self {
         let mut counts = parser.counts;
@@ -66,39 +64,16 @@ impl<'a> Walk<'a> {
             }
             _ => None,
         };
-        // A quiet line right after the candidate: it filled the burst from one quiet line to
-        // the next (Tentative), or its own count already continues.
-        let quiet_vouches = match chain {
-            // A reply nobody awaits that fills the line from a boundary up to the quiet line.
-            Chain::Exact => parser.lock != Lock::Hunting,
-            Chain::Own | Chain::Restart => false,
-            // A far count on a boundary that fills the line up to the quiet.
-            Chain::Rebase => parser.lock != Lock::Hunting,
-            // Hunting, a quiet line vouches only for the awaited reply and a count that
-            // continues exactly and fits no other stream, outside a frame rejected on a
-            // boundary: a false frame in a damaged frame's tail ends exactly where the line goes
-            // quiet, on that frame's count byte.
-            Chain::Verify => {
-                parser.lock == Lock::Tentative
-                    || matches!(class, Class::Expected { .. } | Class::Continues)
-            }
-        };
-        let gap = if class == Class::Continues {
-            MAX_GAP
-        } else {
-            0
-        };
         Walk {
             parser,
             buf,
-            class,
-            chain,
+            rule,
+            chain: rule.chain,
             quiet,
             counts,
             own,
-            quiet_vouches,
             pos: len,
-            gap,
+            gap: rule.gap,
             own_step: None,
             skipped: false,
         }
@@ -115,7 +90,7 @@ impl<'a> Walk<'a> {
                         return Continue((at, kind));
                     }
                 }
-                (None, _) if at == pos && quiet => return Break(Ok(self.quiet_vouches)),
+                (None, _) if at == pos && quiet => return Break(Ok(self.rule.quiet)),
                 (Some(a), None) if Kind::may_start(*a) && !quiet => {
                     return Break(undecided(buf, 1));
                 }
@@ -177,7 +152,7 @@ impl<'a> Walk<'a> {
         // The master asked once: an awaited reply whose chain holds another reply with the same
         // code is not the answer (a `23` and the code in a damaged frame's tail, the real reply
         // further on).
-        if matches!(self.class, Class::Expected { .. })
+        if self.rule.once
             && matches!(next, Downlink::Reply(reply) if self.parser.expect == Some(reply.code))
         {
             return Break(Ok(false));
@@ -242,7 +217,7 @@ impl<'a> Walk<'a> {
         let vouches = self.may_vouch(stream, seq)?;
         match self.counts.rel(stream, seq, at) {
             Rel::Continues if vouches => Break(Ok(true)),
-            Rel::Near if vouches => Break(Ok(self.chain != Chain::Exact)),
+            Rel::Near if vouches => Break(Ok(true)),
             Rel::Continues | Rel::Near | Rel::Unknown => {
                 self.counts.take(stream, seq, false);
                 Continue(())
@@ -291,7 +266,7 @@ impl DownlinkParser {
         buf: &[u8],
         frame: &Downlink,
         len: usize,
-        rule: (Class, Chain),
+        rule: Rule,
         quiet: bool,
     ) -> Result<bool, usize> {
         let mut walk = Walk::new(self, buf, frame, len, rule, quiet);
@@ -330,15 +305,15 @@ impl DownlinkParser {
         let Some(frame) = Downlink::read(kind, bytes) else {
             return Verdict::Reject;
         };
-        let class = self.class(&frame, 0);
-        let taken = match rules::need(self.start(), class) {
+        let facts = self.facts(&frame);
+        let taken = match rules::decide(self.start(), facts).1 {
             Need::Now => Ok(true),
             Need::Never => Ok(false),
             Need::Follow => followed(buf, len, quiet).ok_or(1),
-            Need::Chain(chain) => self.chain(buf, &frame, len, (class, chain), quiet),
+            Need::Chain(rule) => self.chain(buf, &frame, len, rule, quiet),
         };
         match taken {
-            Ok(true) => Verdict::Accept(frame, len, class),
+            Ok(true) => Verdict::Accept(frame, len, facts.seen),
             Ok(false) => Verdict::Reject,
             Err(more) => Verdict::NeedMore(more.max(1)),
         }

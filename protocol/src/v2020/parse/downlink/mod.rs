@@ -1,167 +1,55 @@
 //! The board → master streaming parser: telemetry and replies out of a noisy byte stream.
 //!
-//! # Why this is not a plain state machine over one frame
+//! There is no checksum and no length byte (A7); `FF FA`..`FF FC` are -6..-4 as big-endian
+//! `i16`, so a gyro at rest writes false headers into payloads, and `23` is an ordinary byte.
+//! **One principle:** a frame is taken on evidence that does not rest on the bytes it could be
+//! hiding in — where it starts, its count byte against the steps the line has taught
+//! ([`counts`]: A10 does not say what it counts), and what follows it — and the less sure its
+//! start, the more of what follows must vouch. The parser keeps a window of up to [`WINDOW`]
+//! bytes from the candidate's first byte; the facts about a candidate are gathered (`class.rs`,
+//! [`rules::Facts`]) and **one table decides** ([`rules::decide`], first row that holds, a test
+//! per row; the reasons for each row: `docs/parser.md`):
 //!
-//! There is no checksum and no length byte (ambiguity A7). `FF FA`, `FF FB` and `FF FC` are
-//! -6, -5 and -4 as big-endian `i16`, so a gyro at rest writes false headers into IMU payloads
-//! all the time, and `23` (a reply's `#`) is an ordinary byte. UARTs drop bytes on overrun,
-//! lines pick up noise, and a master may start listening mid-frame. The parser keeps a window of
-//! up to [`WINDOW`] bytes from the start of the candidate frame it is judging, and weighs:
-//!
-//! 1. **The header** (`FF FA` / `FF FB` / `FF FC`, or `23` and a reply code the spec defines):
-//!    it fixes the frame's length.
-//! 2. **The count byte**, against what the line has taught ([`counts`]): the vendor does not
-//!    say what it counts (A10), so the parser learns each stream's steps from the line (per
-//!    stream +1 or +k, one counter shared by all streams, a time tick: all work).
-//! 3. **Where it starts**: right after a frame taken on good evidence (*Locked*; *Resynced*
-//!    when that frame was found while hunting), right after a quiet line (*Tentative*), or
-//!    anywhere (*Hunting*). Rows that say Locked hold for Resynced too, but row 5.
-//! 4. **What follows**: a header right after it, or a **chain**: the frames right after it,
-//!    back to back, reaching one whose count continues its stream (counting the candidate).
-//! 5. **Whether a reply is awaited**: the master knows when it asked
-//!    ([`DownlinkParser::expect_reply`]); the board answers reads only.
-//!
-//! # The rules
-//!
-//! One table, one function ([`rules::need`]), a test per row:
-//!
-//! | # | where the candidate starts | what it is | taken |
+//! | # | where it starts | what it is | taken |
 //! |---|---|---|---|
-//! | 1 | Locked or Tentative | telemetry, count continues (or fits two streams) | on its last byte |
-//! | 2 | Locked or Tentative | the awaited reply, no telemetry header inside its value | on its last byte |
-//! | 3 | Locked or Tentative | the awaited reply that could hide a cut frame | with a header (or quiet line) after it |
-//! | 4 | Locked | telemetry, count near (frames lost) or the stream's first | with a header (or quiet line) after it |
-//! | 5 | Locked (not Resynced) | telemetry, count far | when the chain after it vouches, far counts in it re-based |
-//! | 6 | Tentative | telemetry, count near (the board paused) | with a header (or quiet line) after it |
-//! | 7 | Tentative | telemetry, the stream's first or a far count | when the chain vouches (far counts in it re-based), or it fills the burst up to the next quiet line |
-//! | 8 | Hunting | telemetry, count continues or near (and fits no other stream) | when the chain vouches (or, the count continuing exactly, the quiet line right after it) |
-//! | 9 | Hunting | telemetry, the stream's first, a count another stream's could explain (but the stream of a frame rejected on a boundary right before it), any count inside a frame rejected on a boundary, or a count that is a telemetry header's second byte (its last two bytes a header) | when its own stream's next frame in the chain continues it |
-//! | 10 | Hunting | the awaited reply, not inside a frame rejected on a boundary | when the chain (or a quiet line) vouches, and the chain holds no other reply with its code |
-//! | 11 | Locked or Tentative | a reply nobody awaits | when the very next frame's count continues exactly (or the quiet line ends it); Locked, past a damaged next frame, when the frame after it continues |
-//! | 12 | Hunting | a reply nobody awaits, or the awaited code inside a frame rejected on a boundary | never |
-//! | 13 | Hunting or Resynced | telemetry, count far | when its own stream's next three frames in the chain move on from it in step (the board restarted its counts) |
-//! | 14 | Hunting | telemetry whose last bytes are a frame of another stream that lost or gained a byte, or, inside a frame rejected on a boundary and with a count not near its own stream's, a whole one; ending on the same count byte, which fits that stream; telemetry that is the tail of a frame of another stream that lost its first byte; telemetry starting in a reply's value whose tail, from the reply's end, is a whole frame of another stream (same count byte, which fits it); or, inside a frame rejected on a boundary, telemetry over the header where that frame, a byte short or long, ends, or telemetry of its kind from its byte 2 (its tail, had it gained two bytes) | never (a whole inner frame: the scan reaches it next) |
-//! | 15 | any | telemetry, count far, its last two bytes a telemetry header (a cut frame running into the next one) | never |
+//! | 14 | Hunting | telemetry whose bytes hold a real frame it cannot be | never |
+//! | 15 | any | a far count that is a header's second byte (a cut frame) | never |
+//! | 1 | a boundary | telemetry, count continues | on its last byte |
+//! | 4 | Locked, Resynced | telemetry, count near, or the stream's first | with a header after it |
+//! | 5 | Locked | telemetry, count far | a chain, re-basing (or the quiet line) |
+//! | 6 | Tentative | telemetry, count near | with a header after it |
+//! | 7 | Tentative | telemetry, the stream's first or a far count | a chain, re-basing (or the quiet line) |
+//! | 13 | Hunting, Resynced | telemetry, count far | its stream's next three frames in step |
+//! | 9 | Hunting | the stream's first; a count inside a rejected frame, another stream's too, or a header's byte | its own stream's next frame |
+//! | 8 | Hunting | telemetry, count continues or near | a chain (continuing: or the quiet line) |
+//! | 2 | a boundary | the awaited reply, no header in its value | on its last byte |
+//! | 3 | a boundary | the awaited reply, a header in its value | with a header after it |
+//! | 11 | a boundary | a reply nobody awaits | the next frame's count exactly (or the quiet line) |
+//! | 10 | Hunting | the awaited reply, not inside a rejected frame | a chain or the quiet line, no second reply of its code |
+//! | 12 | Hunting | any other reply | never |
 //!
-//! *A frame of another stream that lost or gained a byte* (row 14): its header inside the
-//! candidate, where a frame of its stream one byte shorter (or longer) ends on the candidate's
-//! count byte, and that count fits its stream: a damaged real frame, behind bytes that happen to
-//! hold a header (under one counter shared by all streams, or a time tick, the count fits the
-//! outer stream too, and the frames after it continue both). The inner frame cannot be taken
-//! itself, so rejecting the outer one lets nothing false through. (A *whole* inner frame outside
-//! a rejected frame is not enough: measured, rejecting the outer frame there cost recall and let
-//! the inner, false, one through.) Inside a frame rejected on a boundary, the outer frame is
-//! judged by a whole inner one only when its own count is not near: a frame cut short by a
-//! dropout leaves the next whole frames in its length, with counts a few frames on.
+//! *Locked*: right after a frame taken on a boundary; *Resynced*: right after one found while
+//! hunting; *Tentative*: right after a quiet line; *Hunting*: anywhere. A *chain* is the frames
+//! right after the candidate, back to back, reaching one whose count continues its stream
+//! ([`rules::Chain`] says which links count). With no step learnt, a stream's first frame found
+//! while hunting needs three more of its stream, equally spaced by 1 to
+//! [`counts::FIRST_STEP_MAX`].
 //!
-//! *The tail of a frame that lost its first byte* (row 14): a lone `FA`..`FC` among the bytes
-//! thrown away right before the candidate (not after an `FF`), where the rest of a frame of that
-//! stream ends on the candidate's count byte, which fits that stream: an encoder frame's header
-//! in an IMU frame's payload (accel Y of -5) whose own `FF` was lost.
-//!
-//! *Resynced* (rows 5 and 13): right after a frame found while hunting, the boundary is only as
-//! sure as that frame. Lookalikes in adversarial payloads come back to back (each ends where
-//! the next starts); once one is taken, the next has a boundary of sorts, and a far count
-//! there re-based by a chain of more lookalikes let a run of false frames through after a
-//! dropout. A far count there needs what it needs while hunting.
-//!
-//! *Starting in a reply's value* (row 14): the two bytes thrown away right before the
-//! candidate are `23` and a reply code, and from where that reply ends (four bytes in) the
-//! candidate's tail is a whole frame of another stream, ending on the candidate's count byte,
-//! which fits that stream: a reply nobody awaits (never taken while hunting) whose value starts
-//! `FF FA`, then a real encoder frame; under one counter shared by all streams, or a time tick,
-//! the encoder frame's count continues the IMU stream too.
-//!
-//! *Over the header where the rejected frame ends* (row 14): inside a frame rejected on a
-//! boundary, a telemetry header inside the candidate right where that frame ends if it lost
-//! (or gained) a byte is the next real frame: both cannot be real, and the scan reaches it
-//! next. Lookalikes back to back in adversarial payloads, each a count on from the one before
-//! (under one counter shared by all streams, when the counts pass `FA`..`FC`, payload bytes
-//! are counts too), vouched for each other there, over the real frames. And *its tail from its
-//! byte 2* (row 14): a frame that gained two bytes inside is rejected on its boundary; from its
-//! byte 2, a frame of its kind ends on its count byte, which continues its stream. A real frame
-//! starts there only if a dropout cut the rejected one right after its header and ended right
-//! at a frame's start.
-//!
-//! *Inside a frame rejected on a boundary* (rows 9, 12 and 14): a candidate that starts within
-//! the length the rejected frame's header promised, less [`MAX_DROPPED`] bytes it may have lost.
-//! A real frame starts there only if the rejected one lost more bytes than that (a dropout), so
-//! a count that continues there is no evidence: a byte inserted into a frame leaves its last
-//! bytes and the next frame's header in the window, and payload bytes repeat counts. Nor is the
-//! awaited reply's code: `23` and a code in a damaged frame's payload end on its count byte,
-//! right where the next frame starts, so the chain after it vouches as well as for a real one.
-//! Where a frame rejected on a boundary ends if it lost or gained a byte (or had its count byte
-//! changed) is a boundary too: a frame rejected there casts the same shadow (two damaged
-//! frames in a row, the second's payload holding a lookalike over the next frame's header).
-//!
-//! *The master asked once* (row 10): a chain after the awaited reply that holds another reply
-//! with the same code (the real one, after a `23` and the code in a damaged frame's tail) does
-//! not vouch for it.
-//!
-//! *Past a damaged next frame* (row 11): a reply nobody awaits on a certain boundary, whose next
-//! frame lost a byte inside (its count byte is then the next header's first), lost its header's
-//! first byte, or gained a byte, is taken when the frame right after the damaged one (where
-//! that damage puts it) continues its stream, the damaged frame counted as one of its stream.
-//! A damaged frame of the right length (a changed count byte) does not say which of the two is
-//! wrong, and does not vouch.
-//!
-//! *The chain vouches* ([`rules::Chain`]) when the frames right after the candidate, back to
-//! back, reach one whose count continues (or is near) its stream's count, counting the
-//! candidate itself and the chain's frames before it; frames of streams with no count yet pass
-//! it on, replies too; a far count ends it (fails), except on a certain boundary (row 5) where
-//! it re-bases. A frame whose last two bytes are a telemetry header (its count byte the next
-//! header's second, as in row 15) is passed over: its count is no evidence (a frame cut by a
-//! dropout that ended on a header's second byte, re-based on that `FA`, and a lookalike in the
-//! next payload ending on the following header's `FB` continued each other). A frame of the
-//! candidate's own stream sooner after it than the board's rates
-//! allow on a line that carries IMU frames ([`Counts::too_soon`]: an encoder frame within 60
-//! bytes, a battery frame within 1 500) fails it: both cannot be real (battery lookalikes back
-//! to back in a payload, their counts a learnt step apart by chance). A candidate whose count
-//! continues exactly may have up to two junk bytes before its chain, unless they are the tail
-//! of a frame from the boundary right before the bytes thrown away ahead of the candidate (its
-//! first `FF`), which lost or gained a byte and ends where the chain starts: the chain vouches
-//! for that frame, not for the candidate inside it. A quiet line right after
-//! the candidate vouches for it after a quiet line (Tentative), for the awaited reply, and,
-//! while hunting, for telemetry whose count continues exactly and fits no other stream,
-//! outside a frame rejected on a boundary (the frame after a damaged one in the same burst);
-//! never for a near count found while hunting or one another stream's could explain (a false
-//! frame in a damaged frame's tail ends where the line goes quiet, on that frame's count
-//! byte), nor for a stream's first frame (any payload can hold a header that ends there). The
-//! chain is looked for within the window; a window full before it decides is a no.
-//!
-//! At start-up nothing is known: a stream's first frame found while hunting then needs three
-//! more frames of its stream in the chain, equally spaced by 1 to 4 counts
-//! ([`counts::FIRST_STEP_MAX`]): sensor bytes drift slowly and payloads repeat a frame's length
-//! apart, so false frames' "counts" can move in small steps for a frame or two, rarely four. A parser that starts listening anywhere emits
-//! nothing until the line has shown it a count. From a quiet line on a clean line (a board
-//! powering up, a capture that starts in an idle stretch), every frame comes out.
-//!
-//! * A rejected candidate costs exactly **one** byte: its first. Scanning goes on over the bytes
-//!   already in the window, so a real frame a false candidate overlapped is still found.
-//! * **A quiet line is time, not amnesia** ([`DownlinkParser::quiet`]): it widens every
-//!   stream's count window by the frames the time could hold (the board pauses telemetry
-//!   while settings are made); the count check never goes away.
-//! * **A count is a guess until its stream continues it**: a count far from one that no frame
-//!   of its own stream has continued yet (a false frame passed over in a chain while the line
-//!   was damaged, then a second with no battery frame to correct it) counts as unknown, not far.
-//! * **Steps are learnt only from a line that lost nothing** ([`counts`]): a near count with
-//!   no byte thrown away since its stream's last frame is a step, not frames lost (seen twice:
-//!   a shared counter steps the IMU by 2 after an encoder frame); a count that moved on across
-//!   a loss teaches nothing (it may be frames lost), and a loss allows frames lost unseen.
-//! * After [`FORGET_AFTER`] bytes without a frame taken, every count is forgotten (the board
-//!   may have restarted): nothing can hold the parser off for ever.
+//! * A rejected candidate costs exactly **one** byte, its first: a real frame a false
+//!   candidate overlapped is still found.
+//! * **A quiet line is time, not amnesia** ([`DownlinkParser::quiet`]): it widens every count
+//!   window by the frames the time could hold; the count check never goes away.
+//! * **Steps are learnt only from a line that lost nothing** ([`counts`]).
+//! * After [`FORGET_AFTER`] bytes without a frame, the counts are forgotten: nothing holds the
+//!   parser off for ever.
 //!
 //! # Memory and time
 //!
-//! Parsing state and counters are one [`DownlinkParser`] (size asserted at compile time). While
-//! Locked, a frame's bytes are only stored; on its last byte a count one learnt step on takes
-//! it (row 1) without the general judgement. Through [`DownlinkParser::frames`] (and
-//! [`DownlinkParser::push_slice`]) such a frame is taken straight from the caller's slice,
-//! never copied, when the window is empty; a frame cut by the end of one slice has its first
-//! bytes stored in one step and is joined with the rest at the start of the next. Junk with
-//! nothing before it costs a few instructions a byte. Each of these shortcuts makes the
-//! decision the rules make, as the property tests check (any chunking, same frames). Nothing
-//! allocates.
+//! One [`DownlinkParser`], its size asserted at compile time; nothing allocates. While locked,
+//! a frame's bytes are only stored and row 1 takes it on its last byte without the general
+//! judgement; [`DownlinkParser::frames`] takes such a frame straight from the caller's slice.
+//! Each shortcut makes the decision the table makes (asserted at compile time against
+//! [`rules::decide`], and by property tests: any chunking, the same frames).
 //!
 //! # Panics
 //!
@@ -253,7 +141,7 @@ pub struct DownlinkParser {
     /// frame's two header bytes (the first is judged with the second). Until the last one, a
     /// byte is only stored.
     missing: u8,
-    /// The frame before the window was found while hunting (see [`Start::Resynced`]).
+    /// The frame before the window was found while hunting (see [`rules::Start::Resynced`]).
     resynced: bool,
     /// What was thrown away right before the window.
     thrown: Thrown,

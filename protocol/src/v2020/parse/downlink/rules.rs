@@ -1,7 +1,10 @@
-//! The acceptance rules: one pure function, [`need`], whose match arms are the rows of the table
-//! in the [module docs](super). Each row has its test below.
+//! The acceptance table: every decision about a whole candidate is a row of [`decide`], read
+//! top to bottom, the first that holds deciding. The facts it reads are gathered elsewhere
+//! ([`Facts`], in `class.rs`) and decide nothing on their own. Each row has its test below;
+//! the table with the reasons is `docs/parser-2020.md`.
 
-use super::Lock;
+use super::counts::Rel;
+use super::{Lock, MAX_GAP};
 
 /// Where the candidate starts, as the rules tell places apart: the parser's [`Lock`], with
 /// Locked split by how the frame before the candidate was found.
@@ -13,9 +16,7 @@ pub enum Start {
     Tentative,
     /// Right after a frame taken on a boundary.
     Locked,
-    /// Right after a frame found while hunting: a boundary only as sure as that frame, which
-    /// may have been a false one among lookalikes (back to back in a payload, each would end
-    /// where the next starts).
+    /// Right after a frame found while hunting: a boundary only as sure as that frame.
     Resynced,
 }
 
@@ -31,77 +32,88 @@ impl From<Lock> for Start {
 
 /// What a whole candidate is, before anything after it is looked at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Class {
-    /// Telemetry whose count is one learnt step on from its stream's last.
-    Continues,
-    /// Telemetry whose count is a few steps on (frames lost).
-    Near,
-    /// Telemetry whose count continues (or is near) its stream's, but would continue another
-    /// stream's too (what a false frame in a damaged frame's tail, ending on that frame's count
-    /// byte, looks like when the streams share a counter or a time tick), that starts inside
-    /// a frame rejected on a boundary (where a continuing count is no evidence), or whose last
-    /// two bytes are a telemetry header (its count a header's second byte). Judged so only
-    /// while hunting.
-    Ambiguous,
-    /// Telemetry of a stream with no count known (its first frame, or after forgetting).
-    First,
-    /// Telemetry whose count is anything else.
-    Far,
-    /// The reply the master waits for (its code), with no telemetry header inside its value
-    /// (`clean`) or with one (it could be a cut reply with the next frame's start in it).
-    Expected {
+pub enum Seen {
+    /// Telemetry, and how its count relates to its stream's ([`Rel`]).
+    Telemetry(Rel),
+    /// A reply: whether the master awaits its code, and whether its value holds no telemetry
+    /// header (`clean`: it cannot be a cut reply with the next frame's start in it).
+    Reply {
+        /// The master awaits this code.
+        awaited: bool,
         /// No `FF FA`..`FF FC` inside its value.
         clean: bool,
     },
-    /// A reply the master is not waiting for (or a parser told nothing), or the awaited code
-    /// found while hunting inside a frame rejected on a boundary.
-    Unexpected,
-    /// Telemetry whose count is far and whose last two bytes are a telemetry header: a frame
-    /// cut short that runs into the next frame's header, its "count" the header's second byte
-    /// (`FA`, `FB`, `FC` are consecutive, so two such cuts in a row look like a count moving on).
-    Cut,
-    /// Found while hunting (see the module docs, row 14): telemetry whose last bytes are a
-    /// frame of another stream that lost or gained a byte, or, inside a frame rejected on a
-    /// boundary (its own count not near), a whole one; ending on the same count byte, whose
-    /// count fits that stream. Bytes that happen to hold a header, then the real frame: both
-    /// cannot be real, and a whole inner one, which starts with its own header, is judged on
-    /// its own when the scan reaches it. Or telemetry that is the tail of a frame of another
-    /// stream that lost its first byte (its lone second header byte just before). Or telemetry
-    /// starting in a reply's value whose tail, from the reply's end, is a whole frame of
-    /// another stream (ending on the same count byte, which fits it). Or, inside a frame
-    /// rejected on a boundary, telemetry over the header where that frame, a byte short or
-    /// long, ends (the next real frame), or telemetry of its kind from its byte 2 (its tail,
-    /// had it gained two bytes).
-    Nested,
 }
 
-/// How a chain of frames after the candidate must vouch for it.
+/// The facts the table reads about a candidate. The suspicions are looked for only where a
+/// row reads them (while hunting, at the window's front).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Facts {
+    /// What it is.
+    pub seen: Seen,
+    /// It starts inside a frame rejected on a boundary: there, a continuing count and the
+    /// awaited code are no evidence (a damaged frame's payload ends where the next starts).
+    pub shadow: bool,
+    /// Its count would continue (or be near) another stream's too.
+    pub other_fits: bool,
+    /// Its last two bytes are a telemetry header: its count byte is a header's second byte.
+    pub cut: bool,
+    /// Its bytes hold a real frame it cannot be (a frame of another stream, damaged or
+    /// whole, ending on its count byte; the tail of a frame that lost its first byte; a frame
+    /// starting in a reply's value; the header where a rejected frame ends): row 14.
+    pub nested: bool,
+}
+
+/// How a chain of frames after the candidate counts: which links vouch, which fail it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Chain {
-    /// The frames right after it, adjacent, reach one whose count continues or is near its
-    /// stream's (counting the candidate and the frames before it in the chain); frames of
-    /// streams with no count are passed over. A quiet line right after the candidate also
-    /// vouches after a quiet line (Tentative), for an expected reply, and, hunting, for a
-    /// count that continues exactly ([`Class::Continues`]).
+    /// The frames right after it reach one whose count continues or is near its stream's
+    /// (counting the candidate and the frames before it); streams with no count pass it on; a
+    /// far count fails it.
     Verify,
-    /// Only the next frame vouches (a stream's first frame is passed over, a reply is not), and
-    /// only if its count continues exactly, or, on a certain boundary (Locked), is near; a quiet
-    /// line vouches when the candidate starts on a boundary (Locked or Tentative) and ends on
-    /// the quiet.
+    /// Only the next frame, continuing exactly (on a certain boundary: or near); a stream's
+    /// first frame is passed over, a reply is not; past a damaged next frame, the one after.
     Exact,
-    /// As `Verify`, but a far count in the chain re-bases its stream instead of failing it (a
-    /// damaged count byte on a certain boundary, or a board that restarted its counts).
+    /// As `Verify`, but a far count re-bases its stream instead of failing.
     Rebase,
-    /// Only a later frame of the candidate's own stream, continuing the candidate's count,
-    /// vouches: a stream's first frame found while hunting could be any payload's tail, and
-    /// frames of other streams after it say nothing of its own count. Right after a quiet line
-    /// (Tentative), a candidate that the next quiet line ends exactly (it is the whole burst)
-    /// is vouched for too.
+    /// Only a later frame of the candidate's own stream continuing it vouches.
     Own,
-    /// As `Own`, but always three more frames of the stream, equally spaced: a far count found
-    /// while hunting (the board restarted its counts) is taken only when the line shows the
-    /// new count moving in step.
+    /// As `Own`, but three more frames of the stream, equally spaced (a board that restarted
+    /// its counts).
     Restart,
+}
+
+/// A chain and what else may vouch for the candidate while it is walked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Walk {
+    /// How the links count.
+    pub chain: Chain,
+    /// A quiet line right after the candidate vouches for it.
+    pub quiet: bool,
+    /// Junk bytes allowed before the chain's first frame.
+    pub gap: usize,
+    /// The master asked once: a chain holding another reply with the awaited code fails.
+    pub once: bool,
+}
+
+impl Walk {
+    /// A chain with nothing else vouching.
+    pub const fn only(chain: Chain) -> Walk {
+        Walk {
+            chain,
+            quiet: false,
+            gap: 0,
+            once: false,
+        }
+    }
+
+    /// A chain, or the quiet line right after the candidate.
+    const fn or_quiet(chain: Chain) -> Walk {
+        Walk {
+            quiet: true,
+            ..Walk::only(chain)
+        }
+    }
 }
 
 /// What the candidate needs to be taken.
@@ -112,173 +124,261 @@ pub enum Need {
     /// A header (or a quiet line) right after it.
     Follow,
     /// A chain of frames after it that vouches for it.
-    Chain(Chain),
+    Chain(Walk),
     /// Never: drop its first byte.
     Never,
 }
 
-/// The rules. `start`: how sure the parser is that the candidate starts where a frame starts
-/// (Locked: right after a frame taken on good evidence, Resynced if that frame was found while
-/// hunting; Tentative: right after a quiet line; Hunting: anywhere).
-pub const fn need(start: Start, class: Class) -> Need {
-    match (start, class) {
-        // 1. Aligned, the count continues: the fast path.
-        (
-            Start::Locked | Start::Resynced | Start::Tentative,
-            Class::Continues | Class::Ambiguous,
-        ) => Need::Now,
-        // 2. Aligned, the awaited reply, nothing in its value that could be a cut frame.
-        (Start::Locked | Start::Resynced | Start::Tentative, Class::Expected { clean: true }) => {
-            Need::Now
-        }
-        // 3. Aligned, the awaited reply that could hide a cut.
-        (Start::Locked | Start::Resynced | Start::Tentative, Class::Expected { clean: false }) => {
-            Need::Follow
-        }
-        // 4. On a certain boundary, frames lost or a stream's first frame: a header after it.
-        (Start::Locked | Start::Resynced, Class::Near | Class::First) => Need::Follow,
-        // 5. On a certain boundary (not right after a frame found while hunting), a far
-        //    count: the next frames must vouch (re-basing).
-        (Start::Locked, Class::Far) => Need::Chain(Chain::Rebase),
+/// The table: the row that decides, and what the candidate needs. One principle: **a frame
+/// is taken on evidence that does not rest on the bytes it could be hiding in** (its place,
+/// its count against the line's, what follows it), and the less sure its place, the more of
+/// what follows must vouch.
+pub const fn decide(start: Start, f: Facts) -> (u8, Need) {
+    use Chain::{Exact, Own, Rebase, Restart, Verify};
+    use Rel::{Continues, Far, Near, Unknown};
+    use Start::{Hunting, Locked, Resynced, Tentative};
+    let hunting = matches!(start, Hunting);
+    match f.seen {
+        // 14. Hunting, its bytes hold a real frame it cannot be: never (the scan reaches the
+        //     inner frame next).
+        Seen::Telemetry(_) if hunting && f.nested => (14, Need::Never),
+        // 15. A far count that is a header's second byte (a cut frame running into the
+        //     next): never.
+        Seen::Telemetry(Far) if f.cut => (15, Need::Never),
+        // 1. On a boundary, the count continues: taken on its last byte.
+        Seen::Telemetry(Continues) if !hunting => (1, Need::Now),
+        // 4. On a certain boundary, frames lost or the stream's first: a header after it.
+        Seen::Telemetry(Near | Unknown) if matches!(start, Locked | Resynced) => (4, Need::Follow),
+        // 5. On a certain boundary (not found while hunting), a far count: the chain, re-based.
+        Seen::Telemetry(Far) if matches!(start, Locked) => (5, Need::Chain(Walk::or_quiet(Rebase))),
         // 6. After a quiet line, frames lost (the board paused): a header after it.
-        (Start::Tentative, Class::Near) => Need::Follow,
-        // 7. Right after a quiet line (a boundary, but nothing proved yet), nothing to compare
-        //    the count with, or a far one: the chain must vouch, re-basing far counts.
-        (Start::Tentative, Class::First | Class::Far) => Need::Chain(Chain::Rebase),
-        // 8. Hunting, a plausible count: the next frames must vouch (a count that continues
-        //    exactly: or the quiet line right after it).
-        (Start::Hunting, Class::Continues | Class::Near) => Need::Chain(Chain::Verify),
-        // 9. Hunting, a stream's first frame, a count another stream's could explain, any
-        //    count inside a frame rejected on a boundary, or a count that is a header's second
-        //    byte: its own stream's next frame must continue it.
-        (Start::Hunting, Class::First | Class::Ambiguous) => Need::Chain(Chain::Own),
-        // 10. Hunting, the awaited reply (not inside a frame rejected on a boundary): the next
-        //     frames (or the quiet line) must vouch, and hold no other reply with its code.
-        (Start::Hunting, Class::Expected { .. }) => Need::Chain(Chain::Verify),
-        // 11. A reply nobody waits for, on a boundary: the very next frame must continue its
-        //     count exactly (Locked: or, past a damaged next frame, the frame after it).
-        (Start::Locked | Start::Resynced | Start::Tentative, Class::Unexpected) => {
-            Need::Chain(Chain::Exact)
+        Seen::Telemetry(Near) if matches!(start, Tentative) => (6, Need::Follow),
+        // 7. After a quiet line, no count to go by or a far one: the chain, re-based.
+        Seen::Telemetry(Unknown | Far) if matches!(start, Tentative) => {
+            (7, Need::Chain(Walk::or_quiet(Rebase)))
         }
-        // 12. A reply nobody waits for (or the awaited code inside a frame rejected on a
-        //     boundary), hunting: never (the tail of a damaged frame, `23` and a code in its
-        //     payload, ends right where the next real frame starts).
-        (Start::Hunting, Class::Unexpected) => Need::Never,
-        // 13. Hunting, or right after a frame found while hunting, a far count: its own
-        //     stream's next three frames must move on from it in step (a board that restarted
-        //     its counts).
-        (Start::Hunting | Start::Resynced, Class::Far) => Need::Chain(Chain::Restart),
-        // 14. Hunting, a frame of another stream that lost or gained a byte (or, inside a
-        //     frame rejected on a boundary, a whole one) fills the candidate's tail, its count
-        //     fitting; or the candidate is the tail of a frame that lost its first byte; or it
-        //     starts in a reply's value and a whole frame fills it from the reply's end: never
-        //     (a whole inner frame: the scan reaches it next). Only ever found while hunting.
-        (_, Class::Nested) => Need::Never,
-        // 15. A far count that is a header's second byte (the frame ends with a header): never.
-        (_, Class::Cut) => Need::Never,
+        // 13. Hunting, or right after a frame found hunting, a far count: its own stream's
+        //     next three frames in step (a board that restarted its counts).
+        Seen::Telemetry(Far) => (13, Need::Chain(Walk::only(Restart))),
+        // 9. Hunting, the stream's first, or a plausible count that proves nothing (inside
+        //    a rejected frame, another stream's too, a header's second byte): its own
+        //    stream's next frame must continue it.
+        Seen::Telemetry(Unknown) => (9, Need::Chain(Walk::only(Own))),
+        Seen::Telemetry(_) if f.shadow || f.other_fits || f.cut => {
+            (9, Need::Chain(Walk::only(Own)))
+        }
+        // 8. Hunting, the count continues: the chain, up to two junk bytes before it, or the
+        //    quiet line right after it.
+        Seen::Telemetry(Continues) => (
+            8,
+            Need::Chain(Walk {
+                gap: MAX_GAP,
+                ..Walk::or_quiet(Verify)
+            }),
+        ),
+        // 8. Hunting, frames lost: the chain.
+        Seen::Telemetry(Near) => (8, Need::Chain(Walk::only(Verify))),
+        // 2. On a boundary, the awaited reply, nothing in its value that could be a cut
+        //    frame: taken on its last byte.
+        Seen::Reply {
+            awaited: true,
+            clean: true,
+        } if !hunting => (2, Need::Now),
+        // 3. On a boundary, the awaited reply that could hide a cut: a header after it.
+        Seen::Reply { awaited: true, .. } if !hunting => (3, Need::Follow),
+        // 11. On a boundary, a reply nobody awaits: the very next frame's count, exactly.
+        Seen::Reply { awaited: false, .. } if !hunting => (11, Need::Chain(Walk::or_quiet(Exact))),
+        // 10. Hunting, the awaited reply (not inside a rejected frame): the chain or the
+        //     quiet line, holding no other reply with its code.
+        Seen::Reply { awaited: true, .. } if !f.shadow => (
+            10,
+            Need::Chain(Walk {
+                once: true,
+                ..Walk::or_quiet(Verify)
+            }),
+        ),
+        // 12. Hunting, a reply nobody awaits (or the awaited code inside a rejected frame):
+        //     never (`23` and a code in a damaged frame's payload ends where the next starts).
+        Seen::Reply { .. } => (12, Need::Never),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use Rel::{Continues, Far, Near, Unknown};
     use Start::{Hunting, Locked, Resynced, Tentative};
+
+    const ALIGNED: [Start; 3] = [Locked, Resynced, Tentative];
+
+    fn telemetry(rel: Rel) -> Facts {
+        Facts {
+            seen: Seen::Telemetry(rel),
+            shadow: false,
+            other_fits: false,
+            cut: false,
+            nested: false,
+        }
+    }
+
+    fn reply(awaited: bool, clean: bool) -> Facts {
+        Facts {
+            seen: Seen::Reply { awaited, clean },
+            ..telemetry(Unknown)
+        }
+    }
+
+    fn row(start: Start, facts: Facts) -> u8 {
+        decide(start, facts).0
+    }
 
     #[test]
     fn row1_aligned_and_continuing_is_taken_at_once() {
-        for lock in [Locked, Resynced, Tentative] {
-            assert_eq!(need(lock, Class::Continues), Need::Now);
-            assert_eq!(need(lock, Class::Ambiguous), Need::Now);
+        for start in ALIGNED {
+            assert_eq!(decide(start, telemetry(Continues)), (1, Need::Now));
+            // What only hunting reads changes nothing on a boundary.
+            let suspect = Facts {
+                shadow: true,
+                other_fits: true,
+                cut: true,
+                nested: true,
+                ..telemetry(Continues)
+            };
+            assert_eq!(row(start, suspect), 1);
         }
     }
 
     #[test]
     fn row2_the_awaited_reply_on_a_boundary_is_taken_at_once() {
-        assert_eq!(need(Locked, Class::Expected { clean: true }), Need::Now);
-        assert_eq!(need(Tentative, Class::Expected { clean: true }), Need::Now);
+        for start in ALIGNED {
+            assert_eq!(decide(start, reply(true, true)), (2, Need::Now));
+        }
     }
 
     #[test]
     fn row3_an_awaited_reply_that_could_hide_a_cut_waits_for_a_header() {
-        assert_eq!(need(Locked, Class::Expected { clean: false }), Need::Follow);
-        assert_eq!(
-            need(Tentative, Class::Expected { clean: false }),
-            Need::Follow
-        );
+        for start in ALIGNED {
+            assert_eq!(decide(start, reply(true, false)), (3, Need::Follow));
+        }
     }
 
     #[test]
     fn row4_lost_frames_or_a_first_frame_on_a_boundary_wait_for_a_header() {
-        for lock in [Locked, Resynced] {
-            assert_eq!(need(lock, Class::Near), Need::Follow);
-            assert_eq!(need(lock, Class::First), Need::Follow);
+        for start in [Locked, Resynced] {
+            assert_eq!(decide(start, telemetry(Near)), (4, Need::Follow));
+            assert_eq!(decide(start, telemetry(Unknown)), (4, Need::Follow));
         }
     }
 
     #[test]
     fn row5_a_far_count_on_a_boundary_needs_the_chain_to_rebase() {
-        assert_eq!(need(Locked, Class::Far), Need::Chain(Chain::Rebase));
+        let need = Need::Chain(Walk::or_quiet(Chain::Rebase));
+        assert_eq!(decide(Locked, telemetry(Far)), (5, need));
     }
 
     #[test]
     fn row6_frames_lost_over_a_quiet_line_wait_for_a_header() {
-        assert_eq!(need(Tentative, Class::Near), Need::Follow);
+        assert_eq!(decide(Tentative, telemetry(Near)), (6, Need::Follow));
     }
 
     #[test]
     fn row7_after_a_quiet_line_no_count_to_go_by_needs_the_chain() {
-        assert_eq!(need(Tentative, Class::First), Need::Chain(Chain::Rebase));
-        assert_eq!(need(Tentative, Class::Far), Need::Chain(Chain::Rebase));
+        let need = Need::Chain(Walk::or_quiet(Chain::Rebase));
+        assert_eq!(decide(Tentative, telemetry(Unknown)), (7, need));
+        assert_eq!(decide(Tentative, telemetry(Far)), (7, need));
     }
 
     #[test]
     fn row8_hunting_a_plausible_count_needs_the_chain() {
-        for class in [Class::Continues, Class::Near] {
-            assert_eq!(need(Hunting, class), Need::Chain(Chain::Verify));
+        let continues = Walk {
+            gap: MAX_GAP,
+            ..Walk::or_quiet(Chain::Verify)
+        };
+        assert_eq!(
+            decide(Hunting, telemetry(Continues)),
+            (8, Need::Chain(continues))
+        );
+        let near = Need::Chain(Walk::only(Chain::Verify));
+        assert_eq!(decide(Hunting, telemetry(Near)), (8, near));
+    }
+
+    #[test]
+    fn row9_hunting_a_first_frame_or_a_count_that_proves_nothing_needs_its_own_stream() {
+        let own = Need::Chain(Walk::only(Chain::Own));
+        assert_eq!(decide(Hunting, telemetry(Unknown)), (9, own));
+        for rel in [Continues, Near] {
+            let shadow = Facts {
+                shadow: true,
+                ..telemetry(rel)
+            };
+            let other = Facts {
+                other_fits: true,
+                ..telemetry(rel)
+            };
+            let cut = Facts {
+                cut: true,
+                ..telemetry(rel)
+            };
+            for facts in [shadow, other, cut] {
+                assert_eq!(decide(Hunting, facts), (9, own));
+            }
         }
     }
 
     #[test]
-    fn row9_hunting_a_first_frame_or_an_ambiguous_count_needs_its_own_stream() {
-        assert_eq!(need(Hunting, Class::First), Need::Chain(Chain::Own));
-        assert_eq!(need(Hunting, Class::Ambiguous), Need::Chain(Chain::Own));
-    }
-
-    #[test]
     fn row10_hunting_the_awaited_reply_needs_the_chain_or_the_quiet() {
-        assert_eq!(
-            need(Hunting, Class::Expected { clean: true }),
-            Need::Chain(Chain::Verify)
-        );
+        let need = Need::Chain(Walk {
+            once: true,
+            ..Walk::or_quiet(Chain::Verify)
+        });
+        assert_eq!(decide(Hunting, reply(true, true)), (10, need));
+        assert_eq!(decide(Hunting, reply(true, false)), (10, need));
     }
 
     #[test]
     fn row11_a_reply_nobody_waits_for_on_a_boundary_needs_an_exact_count_after_it() {
-        for lock in [Tentative, Locked, Resynced] {
-            assert_eq!(need(lock, Class::Unexpected), Need::Chain(Chain::Exact));
+        for start in ALIGNED {
+            let need = Need::Chain(Walk::or_quiet(Chain::Exact));
+            assert_eq!(decide(start, reply(false, true)), (11, need));
         }
     }
 
     #[test]
     fn row12_hunting_never_takes_a_reply_nobody_waits_for() {
-        assert_eq!(need(Hunting, Class::Unexpected), Need::Never);
-    }
-
-    #[test]
-    fn row14_a_frame_whose_tail_is_another_streams_frame_inside_a_rejected_one_is_never_taken() {
-        assert_eq!(need(Hunting, Class::Nested), Need::Never);
-    }
-
-    #[test]
-    fn row15_a_far_count_that_is_the_next_headers_second_byte_is_never_taken() {
-        for lock in [Hunting, Tentative, Locked, Resynced] {
-            assert_eq!(need(lock, Class::Cut), Need::Never);
-        }
+        assert_eq!(decide(Hunting, reply(false, true)), (12, Need::Never));
+        let in_shadow = Facts {
+            shadow: true,
+            ..reply(true, true)
+        };
+        assert_eq!(decide(Hunting, in_shadow), (12, Need::Never));
     }
 
     #[test]
     fn row13_hunting_or_right_after_a_frame_found_hunting_a_far_count_needs_its_stream_in_step() {
-        assert_eq!(need(Hunting, Class::Far), Need::Chain(Chain::Restart));
-        assert_eq!(need(Resynced, Class::Far), Need::Chain(Chain::Restart));
+        let need = Need::Chain(Walk::only(Chain::Restart));
+        assert_eq!(decide(Hunting, telemetry(Far)), (13, need));
+        assert_eq!(decide(Resynced, telemetry(Far)), (13, need));
+    }
+
+    #[test]
+    fn row14_a_frame_holding_a_real_frame_it_cannot_be_is_never_taken_while_hunting() {
+        for rel in [Continues, Near, Unknown, Far] {
+            let nested = Facts {
+                nested: true,
+                ..telemetry(rel)
+            };
+            assert_eq!(decide(Hunting, nested), (14, Need::Never));
+        }
+    }
+
+    #[test]
+    fn row15_a_far_count_that_is_the_next_headers_second_byte_is_never_taken() {
+        let cut = Facts {
+            cut: true,
+            ..telemetry(Far)
+        };
+        for start in [Hunting, Tentative, Locked, Resynced] {
+            assert_eq!(decide(start, cut), (15, Need::Never));
+        }
     }
 }

@@ -4,9 +4,18 @@
 
 use super::class::telemetry_header;
 use super::counts::Rel;
-use super::rules::{self, Chain, Class, Need, Start};
+use super::rules::{self, Chain, Facts, Need, Seen, Start, Walk};
 use super::{DownlinkParser, FORGET_AFTER, Lock, MAX_DROPPED};
 use crate::telemetry::{self, Downlink, Kind, Stream};
+
+/// Telemetry whose count continues its stream, and nothing else known: row 1's facts.
+const ROW1: Facts = Facts {
+    seen: Seen::Telemetry(Rel::Continues),
+    shadow: false,
+    other_fits: false,
+    cut: false,
+    nested: false,
+};
 
 impl DownlinkParser {
     /// The bytes just stored may have completed the frame at the front of the window: if it is
@@ -49,12 +58,36 @@ impl DownlinkParser {
     /// with that header waits for the rest of that frame. `None`: anything else.
     pub(super) fn unawaited_reply_waits(&self, kind: Kind, bytes: &[u8]) -> Option<usize> {
         // (What row 11 needs, whatever kind of boundary.)
+        const UNAWAITED: Facts = Facts {
+            seen: Seen::Reply {
+                awaited: false,
+                clean: true,
+            },
+            ..ROW1
+        };
         const _: () = assert!(matches!(
             (
-                rules::need(Start::Locked, Class::Unexpected),
-                rules::need(Start::Tentative, Class::Unexpected),
+                rules::decide(Start::Locked, UNAWAITED),
+                rules::decide(Start::Tentative, UNAWAITED),
             ),
-            (Need::Chain(Chain::Exact), Need::Chain(Chain::Exact))
+            (
+                (
+                    11,
+                    Need::Chain(Walk {
+                        chain: Chain::Exact,
+                        gap: 0,
+                        ..
+                    })
+                ),
+                (
+                    11,
+                    Need::Chain(Walk {
+                        chain: Chain::Exact,
+                        gap: 0,
+                        ..
+                    })
+                )
+            )
         ));
         if kind != Kind::Reply || self.lock == Lock::Hunting {
             return None;
@@ -83,10 +116,10 @@ impl DownlinkParser {
         // (Row 1 holds on a boundary whatever kind of boundary it is.)
         const _: () = assert!(matches!(
             (
-                rules::need(Start::Locked, Class::Continues),
-                rules::need(Start::Tentative, Class::Continues),
+                rules::decide(Start::Locked, ROW1),
+                rules::decide(Start::Tentative, ROW1),
             ),
-            (Need::Now, Need::Now)
+            ((1, Need::Now), (1, Need::Now))
         ));
         if self.lock == Lock::Hunting {
             return None;
@@ -267,26 +300,20 @@ impl DownlinkParser {
     }
 
     /// Consumes an accepted frame: counts, counters, lock.
-    pub(super) fn accept(&mut self, frame: &Downlink, len: usize, class: Class) {
-        if let (Class::Continues, Kind::Telemetry(stream), Some(seq)) =
-            (class, frame.kind(), frame.seq())
-        {
-            self.take_continuing(stream, seq, len);
-            return;
-        }
-        // A far count taken on a certain boundary is believed only if its own stream's next
-        // frame continues it (the board moved its count on); otherwise it is a damaged count
-        // byte, and the stream moves on by a step.
-        let believed = class != Class::Far
-            || self.chain(self.buf.as_slice(), frame, len, (class, Chain::Own), false) == Ok(true);
+    pub(super) fn accept(&mut self, frame: &Downlink, len: usize, seen: Seen) {
+        // A far count taken (on a certain boundary, or a restart) is believed only if its own
+        // stream's next frame continues it (the board moved its count on); otherwise it is a
+        // damaged count byte, and the stream moves on by a step.
+        let believed = seen != Seen::Telemetry(Rel::Far)
+            || self.chain(
+                self.buf.as_slice(),
+                frame,
+                len,
+                Walk::only(Chain::Own),
+                false,
+            ) == Ok(true);
         // Frames lost (a near count) teach no step, unless nothing was lost.
-        let near = match (class, frame.kind(), frame.seq()) {
-            (Class::Near, ..) => true,
-            (Class::Ambiguous, Kind::Telemetry(stream), Some(seq)) => {
-                self.counts.rel(stream, seq, 0) == Rel::Near
-            }
-            _ => false,
-        };
+        let near = seen == Seen::Telemetry(Rel::Near);
         self.leave(frame.kind(), len);
         match (frame.kind(), frame.seq(), frame) {
             (Kind::Telemetry(stream), Some(seq), _) if !believed => self.counts.skip(stream, seq),
@@ -306,13 +333,6 @@ impl DownlinkParser {
 }
 
 impl DownlinkParser {
-    /// [`accept`](Self::accept) for telemetry whose count continues its stream (row 1): the
-    /// frame's bytes leave the window, its count and step are taken, the parser is Locked.
-    pub(super) fn take_continuing(&mut self, stream: Stream, seq: u8, len: usize) {
-        self.leave(Kind::Telemetry(stream), len);
-        self.counts.take(stream, seq, true);
-    }
-
     /// A frame of `kind`, `len` bytes, was taken: its bytes leave the window, it is counted, and
     /// the parser is Locked right after it (the counts are the caller's).
     #[inline]
