@@ -129,77 +129,75 @@ pub enum Need {
     Never,
 }
 
+/// What the rows ask: a chain re-basing far counts, or the quiet line right after it.
+const REBASE: Need = Need::Chain(Walk::or_quiet(Chain::Rebase));
+/// Its own stream's next three frames, in step.
+const RESTART: Need = Need::Chain(Walk::only(Chain::Restart));
+/// Its own stream's next frame.
+const OWN: Need = Need::Chain(Walk::only(Chain::Own));
+/// A chain, up to two junk bytes before it, or the quiet line right after it.
+const VERIFY_CONTINUING: Need = Need::Chain(Walk {
+    gap: MAX_GAP,
+    ..Walk::or_quiet(Chain::Verify)
+});
+/// A chain.
+const VERIFY: Need = Need::Chain(Walk::only(Chain::Verify));
+/// The next frame's count, exactly, or the quiet line right after it.
+const EXACT: Need = Need::Chain(Walk::or_quiet(Chain::Exact));
+/// A chain or the quiet line, holding no other reply with the awaited code.
+const VERIFY_ONCE: Need = Need::Chain(Walk {
+    once: true,
+    ..Walk::or_quiet(Chain::Verify)
+});
+
 /// The table: the row that decides, and what the candidate needs. One principle: **a frame
 /// is taken on evidence that does not rest on the bytes it could be hiding in** (its place,
 /// its count against the line's, what follows it), and the less sure its place, the more of
 /// what follows must vouch.
 pub const fn decide(start: Start, f: Facts) -> (u8, Need) {
-    use Chain::{Exact, Own, Rebase, Restart, Verify};
+    use Need::{Follow, Never, Now};
     use Rel::{Continues, Far, Near, Unknown};
     use Start::{Hunting, Locked, Resynced, Tentative};
     let hunting = matches!(start, Hunting);
+    let certain = matches!(start, Locked | Resynced);
     match f.seen {
-        // 14. Hunting, its bytes hold a real frame it cannot be: never (the scan reaches the
-        //     inner frame next).
-        Seen::Telemetry(_) if hunting && f.nested => (14, Need::Never),
-        // 15. A far count that is a header's second byte (a cut frame running into the
-        //     next): never.
-        Seen::Telemetry(Far) if f.cut => (15, Need::Never),
+        // 14. Hunting, its bytes hold a real frame it cannot be (the scan reaches that next).
+        Seen::Telemetry(_) if hunting && f.nested => (14, Never),
+        // 15. A far count that is a header's second byte: a cut frame running into the next.
+        Seen::Telemetry(Far) if f.cut => (15, Never),
         // 1. On a boundary, the count continues: taken on its last byte.
-        Seen::Telemetry(Continues) if !hunting => (1, Need::Now),
+        Seen::Telemetry(Continues) if !hunting => (1, Now),
         // 4. On a certain boundary, frames lost or the stream's first: a header after it.
-        Seen::Telemetry(Near | Unknown) if matches!(start, Locked | Resynced) => (4, Need::Follow),
-        // 5. On a certain boundary (not found while hunting), a far count: the chain, re-based.
-        Seen::Telemetry(Far) if matches!(start, Locked) => (5, Need::Chain(Walk::or_quiet(Rebase))),
+        Seen::Telemetry(Near | Unknown) if certain => (4, Follow),
+        // 5. On a certain boundary (not found while hunting), a far count.
+        Seen::Telemetry(Far) if matches!(start, Locked) => (5, REBASE),
         // 6. After a quiet line, frames lost (the board paused): a header after it.
-        Seen::Telemetry(Near) if matches!(start, Tentative) => (6, Need::Follow),
-        // 7. After a quiet line, no count to go by or a far one: the chain, re-based.
-        Seen::Telemetry(Unknown | Far) if matches!(start, Tentative) => {
-            (7, Need::Chain(Walk::or_quiet(Rebase)))
-        }
-        // 13. Hunting, or right after a frame found hunting, a far count: its own stream's
-        //     next three frames in step (a board that restarted its counts).
-        Seen::Telemetry(Far) => (13, Need::Chain(Walk::only(Restart))),
-        // 9. Hunting, the stream's first, or a plausible count that proves nothing (inside
-        //    a rejected frame, another stream's too, a header's second byte): its own
-        //    stream's next frame must continue it.
-        Seen::Telemetry(Unknown) => (9, Need::Chain(Walk::only(Own))),
-        Seen::Telemetry(_) if f.shadow || f.other_fits || f.cut => {
-            (9, Need::Chain(Walk::only(Own)))
-        }
-        // 8. Hunting, the count continues: the chain, up to two junk bytes before it, or the
-        //    quiet line right after it.
-        Seen::Telemetry(Continues) => (
-            8,
-            Need::Chain(Walk {
-                gap: MAX_GAP,
-                ..Walk::or_quiet(Verify)
-            }),
-        ),
-        // 8. Hunting, frames lost: the chain.
-        Seen::Telemetry(Near) => (8, Need::Chain(Walk::only(Verify))),
-        // 2. On a boundary, the awaited reply, nothing in its value that could be a cut
-        //    frame: taken on its last byte.
+        Seen::Telemetry(Near) if matches!(start, Tentative) => (6, Follow),
+        // 7. After a quiet line, no count to go by or a far one.
+        Seen::Telemetry(Unknown | Far) if matches!(start, Tentative) => (7, REBASE),
+        // 13. Hunting or Resynced, a far count: a board that restarted its counts, or not.
+        Seen::Telemetry(Far) => (13, RESTART),
+        // 9. Hunting, the stream's first, or a count that proves nothing (inside a rejected
+        //    frame, another stream's too, a header's second byte).
+        Seen::Telemetry(Unknown) => (9, OWN),
+        Seen::Telemetry(_) if f.shadow || f.other_fits || f.cut => (9, OWN),
+        // 8. Hunting, the count continues, or frames lost.
+        Seen::Telemetry(Continues) => (8, VERIFY_CONTINUING),
+        Seen::Telemetry(Near) => (8, VERIFY),
+        // 2. On a boundary, the awaited reply, nothing in its value that could be a cut frame.
         Seen::Reply {
             awaited: true,
             clean: true,
-        } if !hunting => (2, Need::Now),
+        } if !hunting => (2, Now),
         // 3. On a boundary, the awaited reply that could hide a cut: a header after it.
-        Seen::Reply { awaited: true, .. } if !hunting => (3, Need::Follow),
-        // 11. On a boundary, a reply nobody awaits: the very next frame's count, exactly.
-        Seen::Reply { awaited: false, .. } if !hunting => (11, Need::Chain(Walk::or_quiet(Exact))),
-        // 10. Hunting, the awaited reply (not inside a rejected frame): the chain or the
-        //     quiet line, holding no other reply with its code.
-        Seen::Reply { awaited: true, .. } if !f.shadow => (
-            10,
-            Need::Chain(Walk {
-                once: true,
-                ..Walk::or_quiet(Verify)
-            }),
-        ),
-        // 12. Hunting, a reply nobody awaits (or the awaited code inside a rejected frame):
-        //     never (`23` and a code in a damaged frame's payload ends where the next starts).
-        Seen::Reply { .. } => (12, Need::Never),
+        Seen::Reply { awaited: true, .. } if !hunting => (3, Follow),
+        // 11. On a boundary, a reply nobody awaits.
+        Seen::Reply { awaited: false, .. } if !hunting => (11, EXACT),
+        // 10. Hunting, the awaited reply, not inside a rejected frame.
+        Seen::Reply { awaited: true, .. } if !f.shadow => (10, VERIFY_ONCE),
+        // 12. Hunting, any other reply (`23` and a code in a damaged frame's payload ends
+        //     where the next frame starts).
+        Seen::Reply { .. } => (12, Never),
     }
 }
 
