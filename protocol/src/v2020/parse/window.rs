@@ -1,75 +1,111 @@
 //! [`Window`]: the few bytes a streaming parser keeps, from the first byte of the candidate
 //! frame it is judging.
 
-/// A fixed buffer of up to `N` bytes that drops bytes from its front.
+/// A fixed buffer of up to `N` bytes (`N` below 256) that drops bytes from its front.
 ///
 /// Rejecting a candidate drops exactly one byte (the candidate's first), so the parser rescans
-/// from the byte after it; accepting a frame drops the frame's bytes. Nothing here can panic.
+/// from the byte after it; accepting a frame drops the frame's bytes. Dropping moves an index,
+/// not the bytes; they move to the front only when the end is reached. Nothing here can panic.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub(crate) struct Window<const N: usize> {
     bytes: [u8; N],
-    len: u8,
+    start: u8,
+    end: u8,
 }
 
 impl<const N: usize> Window<N> {
     pub(crate) const fn new() -> Self {
         Window {
             bytes: [0; N],
-            len: 0,
+            start: 0,
+            end: 0,
         }
     }
 
-    /// The bytes held, oldest first.
     #[inline]
     pub(crate) fn as_slice(&self) -> &[u8] {
         self.bytes
-            .get(..usize::from(self.len))
-            .unwrap_or(&self.bytes)
+            .get(usize::from(self.start)..usize::from(self.end))
+            .unwrap_or(&[])
     }
 
     #[inline]
     pub(crate) const fn len(&self) -> usize {
-        self.len as usize
+        self.end.saturating_sub(self.start) as usize
     }
 
     #[inline]
     pub(crate) const fn is_empty(&self) -> bool {
-        self.len == 0
+        self.len() == 0
     }
 
-    /// Room for `push` without a drop first.
+    /// No room at the end without a byte dropped from the front first.
     #[inline]
     pub(crate) const fn is_full(&self) -> bool {
-        self.len as usize >= N
+        self.len() >= N
     }
 
-    /// Appends `bytes`; returns how many fit.
+    /// Appends one byte if there is room at the end; `false` if not (nothing done).
+    #[inline]
+    pub(crate) fn push(&mut self, byte: u8) -> bool {
+        match self.bytes.get_mut(usize::from(self.end)) {
+            Some(slot) => {
+                *slot = byte;
+                // (`end` indexes the window: no wrap.)
+                self.end = self.end.wrapping_add(1);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Appends what fits of `bytes`; returns how many.
     #[inline]
     pub(crate) fn extend(&mut self, bytes: &[u8]) -> usize {
-        let start = self.len();
-        let mut taken: usize = 0;
-        if let Some(dst) = self.bytes.get_mut(start..) {
-            for (d, s) in dst.iter_mut().zip(bytes) {
-                *d = *s;
-                taken = taken.saturating_add(1);
+        if usize::from(self.end).saturating_add(bytes.len()) > N && self.start > 0 {
+            self.compact();
+        }
+        let end = usize::from(self.end);
+        let taken = bytes.len().min(N.saturating_sub(end));
+        let to = end.saturating_add(taken);
+        match (self.bytes.get_mut(end..to), bytes.get(..taken)) {
+            (Some(dst), Some(src)) => dst.copy_from_slice(src),
+            _ => return 0,
+        }
+        self.end = u8::try_from(to).unwrap_or(self.end);
+        taken
+    }
+
+    /// Moves the bytes kept to the front.
+    pub(crate) fn compact(&mut self) {
+        let (start, end) = (usize::from(self.start), usize::from(self.end));
+        let old = self.bytes;
+        if let Some(src) = old.get(start..end) {
+            if let Some(dst) = self.bytes.get_mut(..src.len()) {
+                dst.copy_from_slice(src);
             }
         }
-        self.len = u8::try_from(start.saturating_add(taken)).unwrap_or(self.len);
-        taken
+        self.end = self.end.saturating_sub(self.start);
+        self.start = 0;
+    }
+
+    /// Forgets every byte kept.
+    #[inline]
+    pub(crate) fn clear(&mut self) {
+        self.start = 0;
+        self.end = 0;
     }
 
     /// Drops the first `n` bytes (all of them if `n` is larger).
     #[inline]
     pub(crate) fn drop_front(&mut self, n: usize) {
-        let len = self.len();
-        let n = n.min(len);
-        // A new array of N (17) bytes, each taken from `n` further on: a fixed-size copy, so no
-        // call to `memmove` (whose general version is 1.5 KB of flash on a Cortex-M), and unlike
-        // `copy_within`, no panic path to reason about.
-        let old = self.bytes;
-        self.bytes = core::array::from_fn(|i| old.get(i.saturating_add(n)).copied().unwrap_or(0));
-        self.len = u8::try_from(len.saturating_sub(n)).unwrap_or(0);
+        let n = u8::try_from(n.min(self.len())).unwrap_or(0);
+        self.start = self.start.saturating_add(n);
+        if self.start >= self.end {
+            self.start = 0;
+            self.end = 0;
+        }
     }
 }
 

@@ -19,7 +19,7 @@ impl DownlinkParser {
                 if self.buf.push(byte) {
                     return self.complete();
                 }
-            } else if self.missing == 0 && self.buf.len() == 0 && !Kind::may_start(byte) {
+            } else if self.missing == 0 && self.buf.is_empty() && !Kind::may_start(byte) {
                 // A byte that starts no frame, with nothing before it: thrown away at once
                 // (most bytes while hunting through noise: kept apart so that it costs little).
                 self.discard_run(&[byte]);
@@ -80,7 +80,7 @@ impl DownlinkParser {
                 Verdict::Accept(frame, len, seen) => {
                     self.accept(&frame, len, seen);
                     // Another frame can be ready at once only if bytes are left.
-                    self.drain = self.buf.len() > 0;
+                    self.drain = !self.buf.is_empty();
                     return Some(frame);
                 }
             }

@@ -55,7 +55,6 @@
 //!
 //! Never, on any input: no indexing, no unchecked arithmetic on any path that bytes reach.
 
-mod buf;
 mod class;
 pub mod counts;
 mod feed;
@@ -64,9 +63,9 @@ pub mod rules;
 mod take;
 
 use super::stats::DownlinkStats;
+use super::window::Window;
 use crate::command::Register;
 use crate::telemetry::{self, Downlink, Kind, Stream};
-use buf::Buf;
 use counts::Counts;
 
 /// Bytes the parser keeps at most: enough for a candidate and the chain after it; at start-up
@@ -126,7 +125,7 @@ pub enum Lock {
 #[derive(Clone, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct DownlinkParser {
-    buf: Buf,
+    buf: Window<WINDOW>,
     counts: Counts,
     lock: Lock,
     /// The reply code awaited, if any.
@@ -194,7 +193,7 @@ impl DownlinkParser {
     #[must_use]
     pub const fn new() -> Self {
         DownlinkParser {
-            buf: Buf::new(),
+            buf: Window::new(),
             counts: Counts::new(),
             lock: Lock::Hunting,
             expect: None,
@@ -237,7 +236,7 @@ impl DownlinkParser {
         }
         while !bytes.is_empty() {
             // With nothing kept, bytes that start no frame are thrown away at once.
-            if self.buf.len() == 0 {
+            if self.buf.is_empty() {
                 let junk = bytes.iter().take_while(|b| !Kind::may_start(**b)).count();
                 if junk > 0 {
                     self.discard_run(bytes.get(..junk).unwrap_or(&[]));

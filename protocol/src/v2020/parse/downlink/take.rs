@@ -190,7 +190,7 @@ impl DownlinkParser {
     /// before its last byte: they are stored (`true`). `false`: nothing done.
     #[inline]
     pub(super) fn store_cut(&mut self, bytes: &[u8]) -> bool {
-        if self.drain || self.buf.len() > 0 {
+        if self.drain || !self.buf.is_empty() {
             return false;
         }
         let Some(kind) = (match bytes {
