@@ -36,6 +36,9 @@ pub enum Payload {
     /// Written to fool a parser: about a third of all 16-bit fields read `FF FA`..`FF FC`, a
     /// third `23` and a reply code; reply values likewise.
     Adversarial,
+    /// Every payload byte (values and counts aside) drawn from `FF FA FB FC 23` and the reply
+    /// codes: lookalike headers and `#`s everywhere, far denser than [`Adversarial`](Self::Adversarial).
+    Headers,
 }
 
 /// What the count byte counts (A10: the vendor does not say).
@@ -47,6 +50,8 @@ pub enum CountModel {
     Shared,
     /// A 10 ms time tick: IMU +1, encoders +4, battery +100.
     Tick,
+    /// One counter shared by all three streams, stepping by this constant per telemetry frame.
+    SharedStep(u8),
 }
 
 impl CountModel {
@@ -66,6 +71,32 @@ pub struct Gap {
     pub offset: usize,
     /// How long the line was quiet, in ms (at least 1).
     pub ms: u32,
+}
+
+/// A stream with its timing: what [`BoardStream::take_timed`] gives.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Timed {
+    /// The bytes, frames back to back as sent.
+    pub bytes: Vec<u8>,
+    /// Each frame with its offset.
+    pub sent: Vec<SentFrame>,
+    /// The quiet stretches of the line.
+    pub gaps: Vec<Gap>,
+    /// When each frame's first byte went out, µs from the start (one per frame of `sent`).
+    pub start_us: Vec<u64>,
+}
+
+impl Timed {
+    /// When each byte has arrived whole at the receiver, µs (86.8 µs per byte at 115 200 bps).
+    pub fn byte_done_us(&self) -> Vec<u64> {
+        let mut done = Vec::with_capacity(self.bytes.len());
+        for (frame, start_us) in self.sent.iter().zip(&self.start_us) {
+            for i in 1..=frame.frame.encode().len() as u64 {
+                done.push(start_us + i * 1_000_000 / 11_520);
+            }
+        }
+        done
+    }
 }
 
 /// A read the master sent, as the master knows it: its reply is awaited from the sent byte at
@@ -173,6 +204,47 @@ impl BoardStream {
         0x2300 | codes[self.rng.random_range(0..codes.len())]
     }
 
+    /// A byte that starts or continues a lookalike: `FF`, `FA`..`FC`, `23` or a reply code.
+    fn header_byte(&mut self) -> u8 {
+        const BYTES: [u8; 14] = [
+            0xFF, 0xFA, 0xFB, 0xFC, 0x23, 0x01, 0x06, 0x07, 0x08, 0x09, 0x0A, 0x0B, 0x0C, 0x20,
+        ];
+        BYTES[self.rng.random_range(0..BYTES.len())]
+    }
+
+    /// Two [`header_byte`](Self::header_byte)s as a big-endian 16-bit value.
+    fn header_word(&mut self) -> u16 {
+        u16::from_be_bytes([self.header_byte(), self.header_byte()])
+    }
+
+    /// A telemetry frame or reply whose payload is header bytes only ([`Payload::Headers`]).
+    fn headers_frame(&mut self, frame: Downlink) -> Downlink {
+        let mut word = || self.header_word() as i16;
+        match frame {
+            Downlink::Imu(imu) => Downlink::Imu(Imu {
+                accel: [word(), word(), word()],
+                gyro: [word(), word(), word()],
+                seq: imu.seq,
+            }),
+            Downlink::Encoders(encoders) => Downlink::Encoders(Encoders {
+                ticks: [word(), word(), word(), word()],
+                seq: encoders.seq,
+            }),
+            Downlink::Battery(battery) => Downlink::Battery(Battery {
+                centivolts: word() as u16,
+                percent: word() as u16,
+                seq: battery.seq,
+            }),
+            Downlink::Reply(reply) => {
+                let value = (u32::from(self.header_word()) << 16) | u32::from(self.header_word());
+                Downlink::Reply(Reply {
+                    code: reply.code,
+                    value,
+                })
+            }
+        }
+    }
+
     fn next_seq(&mut self, stream: usize) -> u8 {
         match self.counts {
             CountModel::PerStream(steps) => {
@@ -182,6 +254,10 @@ impl BoardStream {
             }
             CountModel::Shared => {
                 self.shared = self.shared.wrapping_add(1);
+                self.shared
+            }
+            CountModel::SharedStep(step) => {
+                self.shared = self.shared.wrapping_add(step);
                 self.shared
             }
             CountModel::Tick => (self.now_us / 10_000) as u8,
@@ -276,6 +352,11 @@ impl BoardStream {
             self.replies.sent(&mut self.rng);
             self.reply()
         };
+        let frame = if self.payload == Payload::Headers {
+            self.headers_frame(frame)
+        } else {
+            frame
+        };
         // 86.8 us per byte at 115 200 bps, 8N1.
         self.now_us += frame.encode().len() as u64 * 1_000_000 / 11_520;
         (frame, quiet_us)
@@ -285,25 +366,36 @@ impl BoardStream {
     /// when it falls due, so the line is idle between most frames (about 85 % of the time).
     /// The bytes are the same as `take` gives; a master that watches the line sees the gaps.
     pub fn take_with_gaps(&mut self, count: usize) -> (Vec<u8>, Vec<SentFrame>, Vec<Gap>) {
-        let mut bytes = Vec::with_capacity(count * 15);
-        let mut frames = Vec::with_capacity(count);
-        let mut gaps = Vec::new();
+        let timed = self.take_timed(count);
+        (timed.bytes, timed.sent, timed.gaps)
+    }
+
+    /// [`take_with_gaps`](Self::take_with_gaps), with when each frame's first byte went out.
+    pub fn take_timed(&mut self, count: usize) -> Timed {
+        let mut timed = Timed {
+            bytes: Vec::with_capacity(count * 15),
+            sent: Vec::with_capacity(count),
+            gaps: Vec::new(),
+            start_us: Vec::with_capacity(count),
+        };
         for _ in 0..count {
             let (frame, quiet_us) = self.next_frame_after_quiet();
             // Two characters' time or more is a gap a UART's idle-line detection sees.
-            if quiet_us >= 200 && !bytes.is_empty() {
-                gaps.push(Gap {
-                    offset: bytes.len(),
+            if quiet_us >= 200 && !timed.bytes.is_empty() {
+                timed.gaps.push(Gap {
+                    offset: timed.bytes.len(),
                     ms: (quiet_us / 1_000).max(1) as u32,
                 });
             }
-            frames.push(SentFrame {
-                start: bytes.len(),
+            let len = frame.encode().len() as u64;
+            timed.start_us.push(self.now_us - len * 1_000_000 / 11_520);
+            timed.sent.push(SentFrame {
+                start: timed.bytes.len(),
                 frame,
             });
-            bytes.extend_from_slice(&frame.encode());
+            timed.bytes.extend_from_slice(&frame.encode());
         }
-        (bytes, frames, gaps)
+        timed
     }
 
     /// `count` frames, back to back: the bytes, and each frame with its offset.

@@ -7,11 +7,14 @@
 
 pub mod board;
 pub mod channel;
+pub mod cold;
+pub mod models;
 pub mod qemu;
 mod replies;
 pub mod score;
 pub mod splice;
 pub mod sweep;
+pub mod usb;
 pub mod v1;
 
 pub use board::{BoardStream, CountModel, Gap, Payload, Read, SentFrame, reads_behind};

@@ -68,6 +68,30 @@ impl Score {
         self.latency_sum as f64 / self.recalled.max(1) as f64
     }
 
+    /// The figures before a run of `rx`, the channel's output for `sent`: nothing emitted yet.
+    pub(crate) fn start(sent: &[SentFrame], rx: &Received) -> Score {
+        Score {
+            sent: sent.len(),
+            errors: rx.errors,
+            ..Score::default()
+        }
+    }
+
+    /// The figures after the run: the frames the channel left untouched, the parser's counters.
+    pub(crate) fn finish(
+        mut self,
+        sent: &[SentFrame],
+        rx: &Received,
+        parser: &DownlinkParser,
+    ) -> Score {
+        self.untouched = sent
+            .iter()
+            .filter(|f| rx.untouched(f.start, f.end()))
+            .count();
+        self.stats = *parser.stats();
+        self
+    }
+
     /// Adds another run's figures.
     pub fn add(&mut self, other: &Score) {
         self.sent += other.sent;
@@ -128,67 +152,11 @@ pub fn score_downlink_traced(
     reads: &[Read],
     on_false: &mut dyn FnMut(FalseFrame),
 ) -> Score {
-    let by_start: HashMap<usize, usize> =
-        sent.iter().enumerate().map(|(i, f)| (f.start, i)).collect();
-    let by_last: HashMap<usize, usize> = sent
-        .iter()
-        .enumerate()
-        .map(|(i, f)| (f.end().saturating_sub(1), i))
-        .collect();
-    let mut emitted_at = vec![false; sent.len()];
-    let mut score = Score {
-        sent: sent.len(),
-        errors: rx.errors,
-        ..Score::default()
-    };
+    let mut score = Score::start(sent, rx);
     let mut parser = DownlinkParser::new();
-
+    let mut judge = Judge::new(sent, rx);
     let mut judge = |frame: Downlink, end: usize, now: usize, locked: bool, score: &mut Score| {
-        let len = frame.encode().len();
-        let start = (end + 1).saturating_sub(len);
-        let place = rx
-            .origin
-            .get(start)
-            .copied()
-            .flatten()
-            .and_then(|s| by_start.get(&s).copied());
-        match place {
-            Some(i) if sent[i].frame.kind() == frame.kind() => {
-                let original = &sent[i];
-                if rx.untouched(original.start, original.end())
-                    && original.frame == frame
-                    && !emitted_at[i]
-                {
-                    emitted_at[i] = true;
-                    score.recalled += 1;
-                    let latency = now - end;
-                    score.latency_sum += latency;
-                    score.latency_max = score.latency_max.max(latency);
-                    if locked {
-                        score.recalled_locked += 1;
-                        score.on_time_locked += usize::from(latency == 0);
-                    }
-                } else {
-                    score.damaged += 1;
-                }
-            }
-            _ => {
-                // The sent frame's bytes, whole, behind another `FF` (see the module docs).
-                let whole = rx
-                    .origin
-                    .get(end)
-                    .copied()
-                    .flatten()
-                    .and_then(|last| by_last.get(&last))
-                    .is_some_and(|i| sent[*i].frame == frame);
-                if whole {
-                    score.damaged += 1;
-                } else {
-                    score.false_frames += 1;
-                    on_false(FalseFrame { frame, start, end });
-                }
-            }
-        }
+        judge.judge(frame, (end, now, locked), score, on_false);
     };
 
     // Whether the parser was Locked when each received byte arrived.
@@ -206,13 +174,8 @@ pub fn score_downlink_traced(
                 let end = now.saturating_sub(1);
                 while let Some(frame) = parser.quiet(quiet_ms) {
                     let at = end - parser.buffered();
-                    judge(
-                        frame,
-                        at,
-                        end,
-                        locked_at.get(at).copied().unwrap_or(false),
-                        &mut score,
-                    );
+                    let locked = locked_at.get(at).copied().unwrap_or(false);
+                    judge(frame, at, end, locked, &mut score);
                 }
             }
             while let Some(read) = reads.next_if(|r| r.from <= origin) {
@@ -238,12 +201,81 @@ pub fn score_downlink_traced(
         let end = now - parser.buffered();
         judge(frame, end, now, locked_at[end], &mut score);
     }
-    score.untouched = sent
-        .iter()
-        .filter(|f| rx.untouched(f.start, f.end()))
-        .count();
-    score.stats = *parser.stats();
-    score
+    score.finish(sent, rx, &parser)
+}
+
+/// Judges each frame a parser emits against what was sent and what the channel did to it.
+pub(crate) struct Judge<'a> {
+    sent: &'a [SentFrame],
+    rx: &'a Received,
+    by_start: HashMap<usize, usize>,
+    by_last: HashMap<usize, usize>,
+    emitted_at: Vec<bool>,
+}
+
+impl<'a> Judge<'a> {
+    /// A judge of frames parsed from `rx`, the channel's output for `sent`.
+    pub(crate) fn new(sent: &'a [SentFrame], rx: &'a Received) -> Self {
+        Judge {
+            sent,
+            rx,
+            by_start: sent.iter().enumerate().map(|(i, f)| (f.start, i)).collect(),
+            by_last: sent
+                .iter()
+                .enumerate()
+                .map(|(i, f)| (f.end().saturating_sub(1), i))
+                .collect(),
+            emitted_at: vec![false; sent.len()],
+        }
+    }
+
+    /// Counts `frame`, whose last byte is received byte `end`, emitted when byte `now` was
+    /// in, with the parser Locked (`locked`) when `end` arrived, into `score`.
+    pub(crate) fn judge(
+        &mut self,
+        frame: Downlink,
+        (end, now, locked): (usize, usize, bool),
+        score: &mut Score,
+        on_false: &mut dyn FnMut(FalseFrame),
+    ) {
+        let len = frame.encode().len();
+        let start = (end + 1).saturating_sub(len);
+        let origin = |at: usize| self.rx.origin.get(at).copied().flatten();
+        let place = origin(start).and_then(|s| self.by_start.get(&s).copied());
+        match place {
+            Some(i) if self.sent[i].frame.kind() == frame.kind() => {
+                let original = &self.sent[i];
+                if self.rx.untouched(original.start, original.end())
+                    && original.frame == frame
+                    && !self.emitted_at[i]
+                {
+                    self.emitted_at[i] = true;
+                    score.recalled += 1;
+                    let latency = now - end;
+                    score.latency_sum += latency;
+                    score.latency_max = score.latency_max.max(latency);
+                    if locked {
+                        score.recalled_locked += 1;
+                        score.on_time_locked += usize::from(latency == 0);
+                    }
+                } else {
+                    score.damaged += 1;
+                }
+            }
+            _ => {
+                // The sent frame's bytes, whole, behind another `FF` (see the module docs).
+                let whole = origin(end)
+                    .and_then(|last| self.by_last.get(&last))
+                    .is_some_and(|i| self.sent[*i].frame == frame);
+                if whole {
+                    score.damaged += 1;
+                } else {
+                    score.false_frames += 1;
+                    on_false(FalseFrame { frame, start, end });
+                }
+            }
+        }
+    }
 }
 
 /// What starting to listen in the middle of a clean stream costs.

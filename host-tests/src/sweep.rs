@@ -15,17 +15,34 @@ impl Args {
     /// The process's arguments; on a wrong one, or `--help`, the message (`usage` for `--help`)
     /// is printed after `program` on stderr, and `None` returned.
     pub fn from_env(program: &str, usage: &str) -> Option<Args> {
-        Args::parse(std::env::args().skip(1), usage)
+        Args::from_env_with(program, usage, Args::DEFAULT)
+    }
+
+    /// [`from_env`](Self::from_env), with other defaults.
+    pub fn from_env_with(program: &str, usage: &str, defaults: Args) -> Option<Args> {
+        Args::parse_with(std::env::args().skip(1), usage, defaults)
             .inspect_err(|message| eprintln!("{program}: {message}"))
             .ok()
     }
 
+    /// The defaults: seed 2026, 1 000 000 frames.
+    pub const DEFAULT: Args = Args {
+        seed: 2026,
+        frames: 1_000_000,
+    };
+
     /// `args` (without the program's name); `usage` is the error for `-h` or `--help`.
     pub fn parse(args: impl IntoIterator<Item = String>, usage: &str) -> Result<Args, String> {
-        let mut parsed = Args {
-            seed: 2026,
-            frames: 1_000_000,
-        };
+        Args::parse_with(args, usage, Args::DEFAULT)
+    }
+
+    /// [`parse`](Self::parse), with other defaults.
+    pub fn parse_with(
+        args: impl IntoIterator<Item = String>,
+        usage: &str,
+        defaults: Args,
+    ) -> Result<Args, String> {
+        let mut parsed = defaults;
         let mut it = args.into_iter();
         while let Some(flag) = it.next() {
             let mut value = |name: &str| {

@@ -9,11 +9,15 @@
 //! frames lost per channel error, latency, and the parser's own counters; then every stream model
 //! (payloads, count models, quiet reported or not) with the parser told nothing of the master's
 //! reads, and again with them known (as the driver, or `chassis decode --master`, tells it);
-//! the simulator's stream; and starting to listen mid-stream.
+//! the simulator's stream; starting to listen mid-stream; and last, stream models the parser
+//! was never developed against (payloads of header bytes only, a shared counter stepping by a
+//! constant drawn per seed, the line delivered in USB packets; `chassis_host_tests::models`).
 
 use chassis_host_tests::board::simulator_stream;
 use chassis_host_tests::channel::{Noise, transmit};
+use chassis_host_tests::models::{DELIVERIES, Delivery, PAYLOADS, RATES, count_models, run_model};
 use chassis_host_tests::sweep::Args;
+use chassis_host_tests::usb::Host;
 use chassis_host_tests::{
     BoardStream, CountModel, Payload, Score, reads_behind, score_downlink,
     score_downlink_listening, startup, startup_with_idle,
@@ -175,7 +179,114 @@ fn main() -> ExitCode {
             s.false_frames
         );
     }
+    never_tuned_on(&args);
     ExitCode::SUCCESS
+}
+
+/// The groups of rows whose worst row per error rate the section names after its table.
+const GROUPS: [&str; 4] = [
+    "header bytes only (good hosts)",
+    "shared counter +k (good hosts)",
+    "USB, host watching the gaps",
+    "BAD HOST: idle() after every packet",
+];
+
+/// Which of [`GROUPS`] a row is in.
+fn groups(payload: Payload, counts: CountModel, delivery: Delivery) -> [bool; 4] {
+    let bad = matches!(delivery, Delivery::Usb(_, Host::IdleEveryPacket));
+    [
+        payload == Payload::Headers && !bad,
+        matches!(counts, CountModel::SharedStep(_)) && !bad,
+        matches!(delivery, Delivery::Usb(_, Host::QuietAfter(_))),
+        bad,
+    ]
+}
+
+/// The worst rows of each of [`GROUPS`] at each rate of [`RATES`]: the one with the most false
+/// frames (then the lowest recall), and the one with the lowest recall (then the most false).
+struct Worst {
+    /// `rows[group][rate]`: (false per million, recall, row) of each.
+    most_false: Vec<Vec<(f64, f64, String)>>,
+    lowest_recall: Vec<Vec<(f64, f64, String)>>,
+}
+
+impl Worst {
+    fn new() -> Self {
+        let none = vec![vec![(f64::MIN, f64::MAX, String::new()); RATES.len()]; GROUPS.len()];
+        Worst {
+            most_false: none.clone(),
+            lowest_recall: none,
+        }
+    }
+
+    /// Counts the row `name`, scored `row[rate]`, in `group`.
+    fn note(&mut self, group: usize, name: &str, row: &[Score]) {
+        for (rate, s) in row.iter().enumerate() {
+            let (false_per_million, recall) = (s.false_per_million(), s.recall());
+            let w = &mut self.most_false[group][rate];
+            if (false_per_million, -recall) > (w.0, -w.1) {
+                *w = (false_per_million, recall, name.to_string());
+            }
+            let w = &mut self.lowest_recall[group][rate];
+            if (-recall, false_per_million) > (-w.1, w.0) {
+                *w = (false_per_million, recall, name.to_string());
+            }
+        }
+    }
+
+    fn print(&self) {
+        for (kind, table) in [
+            ("most false frames", &self.most_false),
+            ("lowest recall", &self.lowest_recall),
+        ] {
+            println!();
+            for (group, rows) in GROUPS.iter().zip(table) {
+                for (rate, (false_per_million, recall, row)) in RATES.iter().zip(rows) {
+                    let rate = if *rate > 0.0 {
+                        format!("{rate:.0e}")
+                    } else {
+                        "clean".to_string()
+                    };
+                    println!(
+                        "Worst row ({kind}), {group}, {rate}: {row}: {false_per_million:.1} false frames per million, recall {:.3} %",
+                        recall * 100.0
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// The section of stream models never tuned on: every payload of [`PAYLOADS`], count model
+/// and delivery, at the error rates of [`RATES`]; then the worst rows of each group per rate.
+fn never_tuned_on(args: &Args) {
+    println!(
+        "\nStream models never tuned on ({} frames per row, seed {}, 2 replies/s; mixed channel; each cell: recall / false frames per million):\n",
+        args.frames, args.seed
+    );
+    println!("| payload | count model | delivery | clean | 1e-4 | 1e-3 | 1e-2 |");
+    println!("|---|---|---|---|---|---|---|");
+    let mut worst = Worst::new();
+    let deliveries: Vec<Delivery> = DELIVERIES.iter().map(|(_, d)| *d).collect();
+    for (payload_name, payload) in PAYLOADS {
+        for (count_name, counts) in count_models(args.seed) {
+            let models = (payload, counts);
+            let scores = run_model(args.seed, args.frames, models, &deliveries, &RATES);
+            for ((delivery_name, delivery), row) in DELIVERIES.iter().zip(&scores) {
+                let cells: Vec<String> = row
+                    .iter()
+                    .map(|s| format!("{:.3} % / {:.1}", s.recall() * 100.0, s.false_per_million()))
+                    .collect();
+                let name = format!("{payload_name} | {count_name} | {delivery_name}");
+                println!("| {name} | {} |", cells.join(" | "));
+                let member = groups(payload, counts, *delivery);
+                for (group, _) in member.iter().enumerate().filter(|(_, m)| **m) {
+                    worst.note(group, &name, row);
+                }
+            }
+        }
+    }
+    worst.print();
 }
 
 /// One row per stream model and channel: payloads, every count model, quiet reported or not;

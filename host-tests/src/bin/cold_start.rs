@@ -1,0 +1,115 @@
+//! Cold start, exact from the first byte: for every count model (those of the noise sweep and
+//! a shared counter stepping by a constant drawn from the seed), a new parser starts at every
+//! offset 0..200 of a clean stream of `--frames` frames (payloads at rest), fed one byte at a
+//! time, in random slices of 1..64 bytes or in 62-byte USB packets, with the line's quiet
+//! stretches after the start reported or not. Every frame that starts at or after the start
+//! counts, the first whole one too.
+//!
+//! ```text
+//! cargo run --release -p chassis-host-tests --bin cold-start -- [--frames N] [--seed S]
+//! ```
+
+use chassis_host_tests::cold::{Chunking, Model, cold_start};
+use chassis_host_tests::models::count_models;
+use chassis_host_tests::sweep::Args;
+use chassis_host_tests::{CountModel, Payload};
+use std::process::ExitCode;
+
+/// Start offsets tried in each stream.
+const OFFSETS: std::ops::Range<usize> = 0..200;
+
+fn main() -> ExitCode {
+    let defaults = Args {
+        seed: 2026,
+        frames: 4_000,
+    };
+    let usage = "usage: cold-start [--frames N] [--seed S]";
+    let Some(args) = Args::from_env_with("cold-start", usage, defaults) else {
+        return ExitCode::from(2);
+    };
+    println!(
+        "Cold start on a clean line: every offset {}..{} of a stream of {} frames (payloads at rest, 2 replies/s), seed {}; frames counted from the first that starts at or after the start\n",
+        OFFSETS.start, OFFSETS.end, args.frames, args.seed
+    );
+    let mut summary = Vec::new();
+    for (name, counts) in count_models(args.seed) {
+        let model = Model {
+            seed: args.seed,
+            payload: Payload::Rest,
+            counts,
+            frames: args.frames,
+        };
+        let (missed, false_frames) = model_table(&name, model);
+        summary.push((name, missed, false_frames));
+    }
+    println!(
+        "| count model | frames missed at cold start (worst offset) | false frames (all starts) |"
+    );
+    println!("|---|---|---|");
+    for (name, missed, false_frames) in summary {
+        println!("| {name} | {missed} | {false_frames} |");
+    }
+    every_step(&args);
+    ExitCode::SUCCESS
+}
+
+/// The table of one count model: every chunking, the quiet line reported or not. Returns the
+/// worst start's frames missed and the false frames of all starts.
+fn model_table(name: &str, model: Model) -> (usize, usize) {
+    println!("{name}:\n");
+    println!(
+        "| quiet reported | chunks | starts | frames missed (all starts) | starts missing any | worst start: missed (offset; which) | false frames | starts with a false frame |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    let (mut missed, mut false_frames) = (0, 0);
+    for quiet in [false, true] {
+        for (chunks, chunking) in Chunking::ALL {
+            let c = cold_start(model, OFFSETS, quiet, chunking);
+            println!(
+                "| {} | {chunks} | {} | {} of {} | {} | {} ({}; {:?}) | {} | {} |",
+                if quiet { "yes" } else { "no" },
+                c.starts,
+                c.missed,
+                c.expected,
+                c.starts_missing,
+                c.worst.0,
+                c.worst.1,
+                c.worst_missed,
+                c.false_frames,
+                c.starts_false,
+            );
+            missed = missed.max(c.worst.0);
+            false_frames += c.false_frames;
+        }
+    }
+    println!();
+    (missed, false_frames)
+}
+
+/// The shared counter at every step 1..=7 (the seed draws one), one byte at a time: the worst
+/// start's misses and the false frames, the quiet line reported or not.
+fn every_step(args: &Args) {
+    println!(
+        "\nOne shared counter at every step (1-byte chunks; worst start: frames missed; false frames):\n"
+    );
+    println!(
+        "| step | no quiet: worst missed | no quiet: false | quiet reported: worst missed | quiet reported: false |"
+    );
+    println!("|---|---|---|---|---|");
+    for step in 1..=7 {
+        let model = Model {
+            seed: args.seed,
+            payload: Payload::Rest,
+            counts: CountModel::SharedStep(step),
+            frames: args.frames,
+        };
+        let cells: Vec<String> = [false, true]
+            .into_iter()
+            .map(|quiet| {
+                let c = cold_start(model, OFFSETS, quiet, Chunking::Bytes);
+                format!("{} of {} | {}", c.worst.0, args.frames, c.false_frames)
+            })
+            .collect();
+        println!("| +{step} | {} |", cells.join(" | "));
+    }
+}

@@ -1,0 +1,147 @@
+//! Small versions of the noise sweep's stream models never tuned on (`chassis_host_tests::models`:
+//! payloads of header bytes only, shared counters, the line delivered in USB packets) and of the
+//! cold start (the `cold-start` binary), with the bounds today's parser meets with margin, so a
+//! future parser cannot regress on them silently. The figures today (seed 99, 3 000 frames a
+//! row) are in each test's comments.
+
+use chassis_host_tests::cold::{Chunking, Model, cold_start};
+use chassis_host_tests::models::{DELIVERIES, Delivery, PAYLOADS, run_model};
+use chassis_host_tests::usb::Host;
+use chassis_host_tests::{CountModel, Payload, Score};
+
+/// The seed of every stream here (none of the sweep's figure seeds).
+const SEED: u64 = 99;
+
+/// Frames per row.
+const FRAMES: usize = 3_000;
+
+/// Count models every row runs under: those of the sweep, and shared counters stepping by 3
+/// and by 6 (steps the parser learns; +5 and +7 it does not learn without a quiet line: see
+/// the ignored test below).
+fn count_models() -> Vec<(String, CountModel)> {
+    let mut models: Vec<(String, CountModel)> = CountModel::ALL
+        .iter()
+        .map(|(name, model)| (name.to_string(), *model))
+        .collect();
+    models.push(("shared +3".to_string(), CountModel::SharedStep(3)));
+    models.push(("shared +6".to_string(), CountModel::SharedStep(6)));
+    models
+}
+
+/// Every payload, count model and delivery through mixed errors at `rate`: (row, delivery,
+/// score).
+fn rows(rate: f64) -> Vec<(String, Delivery, Score)> {
+    let deliveries: Vec<Delivery> = DELIVERIES.iter().map(|(_, d)| *d).collect();
+    let mut out = Vec::new();
+    for (payload_name, payload) in PAYLOADS {
+        for (count_name, counts) in count_models() {
+            let scores = run_model(SEED, FRAMES, (payload, counts), &deliveries, &[rate]);
+            for ((delivery_name, delivery), row) in DELIVERIES.iter().zip(scores) {
+                let name = format!("{payload_name} / {count_name} / {delivery_name}");
+                out.extend(
+                    row.into_iter()
+                        .map(|score| (name.clone(), *delivery, score)),
+                );
+            }
+        }
+    }
+    out
+}
+
+/// Checks every row of a host that reports quiet only from the line's timing against the
+/// lowest recall and the most false frames per row, and all rows' false frames per million.
+fn check_good_hosts(rate: f64, min_recall: f64, max_false: usize, max_false_per_million: f64) {
+    let mut all = Score::default();
+    for (name, delivery, s) in rows(rate) {
+        if matches!(delivery, Delivery::Usb(_, Host::IdleEveryPacket)) {
+            continue;
+        }
+        assert!(s.recall() >= min_recall, "{name} at {rate:e}: {s:?}");
+        assert!(s.false_frames <= max_false, "{name} at {rate:e}: {s:?}");
+        all.add(&s);
+    }
+    let per_million = all.false_per_million();
+    assert!(
+        per_million <= max_false_per_million,
+        "{per_million} at {rate:e}"
+    );
+}
+
+#[test]
+fn on_a_clean_line_every_good_host_gets_every_frame_but_the_first_and_nothing_false() {
+    // Today: lowest recall 99.967 % (the first frame, with the quiet reported), 0 false.
+    check_good_hosts(0.0, 0.999, 0, 0.0);
+}
+
+#[test]
+fn at_1e_3_errors_header_bytes_shared_counters_and_usb_packets_hold_their_bounds() {
+    // Today: lowest recall 99.797 % (USB 1 ms), 0 false frames in every row.
+    check_good_hosts(1e-3, 0.995, 1, 50.0);
+}
+
+#[test]
+fn at_1e_2_errors_header_bytes_shared_counters_and_usb_packets_hold_their_bounds() {
+    // Today: lowest recall 97.703 % (header bytes, bytes without the quiet), at most 1 false
+    // frame in a row.
+    check_good_hosts(1e-2, 0.97, 2, 150.0);
+}
+
+#[test]
+fn a_host_that_reports_idle_after_every_usb_packet_loses_frames_not_truth() {
+    // Today such a host gets 1.3–1.7 % of the frames through an adapter that sends every
+    // 1 ms (nearly every frame spans two packets, and idle() throws the first half away), and
+    // 76–79 % through one with a 16 ms latency timer; a few false frames per row (at most 3).
+    // No bound on recall: a parser that did better would be welcome. False frames stay rare.
+    for rate in [0.0, 1e-3] {
+        let mut all = Score::default();
+        for (name, delivery, s) in rows(rate) {
+            if matches!(delivery, Delivery::Usb(_, Host::IdleEveryPacket)) {
+                assert!(s.false_frames <= 6, "{name} at {rate:e}: {s:?}");
+                all.add(&s);
+            }
+        }
+        assert!(all.false_per_million() <= 500.0, "{all:?}");
+    }
+}
+
+/// The worst start's frames missed and the false frames of every offset 0..200 of a stream of
+/// 300 frames (payloads at rest), every chunking, the quiet line reported or not.
+fn cold(counts: CountModel, quiet: bool) -> (usize, usize) {
+    let model = Model {
+        seed: SEED,
+        payload: Payload::Rest,
+        counts,
+        frames: 300,
+    };
+    let mut worst = (0, 0);
+    for (_, chunking) in Chunking::ALL {
+        let c = cold_start(model, 0..200, quiet, chunking);
+        worst = (worst.0.max(c.worst.0), worst.1 + c.false_frames);
+    }
+    worst
+}
+
+#[test]
+fn a_cold_start_misses_no_more_frames_than_today_and_emits_none_false() {
+    for (name, counts) in count_models() {
+        let shared = matches!(counts, CountModel::Shared | CountModel::SharedStep(_));
+        // Today: counts per stream or a tick miss at most the first whole frame without the
+        // quiet line (and 2 with it, at offset 45); a shared counter at most 4.
+        for (quiet, ceiling) in [(false, if shared { 4 } else { 1 }), (true, 2)] {
+            let (missed, false_frames) = cold(counts, quiet);
+            assert!(missed <= ceiling, "{name}, quiet {quiet}: {missed} missed");
+            assert_eq!(false_frames, 0, "{name}, quiet {quiet}");
+        }
+    }
+}
+
+#[test]
+#[ignore = "today's parser misses frames at a cold start: up to 4 under a shared counter +1..+4 or +6 without the quiet line reported, 47-163 at +5 and every frame of the stream at +7 (a shared counter's steps are never learnt from an unbroken line then), and 1-2 (the first whole frame) under every count model"]
+fn a_cold_start_is_exact_from_the_first_whole_frame_under_every_shared_counter() {
+    for step in 1..=7 {
+        for quiet in [false, true] {
+            let (missed, false_frames) = cold(CountModel::SharedStep(step), quiet);
+            assert_eq!((missed, false_frames), (0, 0), "+{step}, quiet {quiet}");
+        }
+    }
+}
