@@ -124,10 +124,12 @@ fn cold(counts: CountModel, quiet: bool) -> (usize, usize) {
 #[test]
 fn a_cold_start_misses_no_more_frames_than_today_and_emits_none_false() {
     for (name, counts) in count_models() {
-        let shared = matches!(counts, CountModel::Shared | CountModel::SharedStep(_));
-        // Today: counts per stream or a tick miss at most the first whole frame without the
-        // quiet line (and 2 with it, at offset 45); a shared counter at most 4.
-        for (quiet, ceiling) in [(false, if shared { 4 } else { 1 }), (true, 2)] {
+        // Every count model misses at most the first whole frame without the quiet line (and
+        // 2 with it, at offset 45: a first burst that ends on the quiet line); a shared
+        // counter stepping by more than 4 (+6 here) more, its steps not learnt from the line
+        // before the quiet.
+        let wide = matches!(counts, CountModel::SharedStep(step) if step > 4);
+        for (quiet, ceiling) in [(false, if wide { 4 } else { 1 }), (true, 2)] {
             let (missed, false_frames) = cold(counts, quiet);
             assert!(missed <= ceiling, "{name}, quiet {quiet}: {missed} missed");
             assert_eq!(false_frames, 0, "{name}, quiet {quiet}");
@@ -136,7 +138,7 @@ fn a_cold_start_misses_no_more_frames_than_today_and_emits_none_false() {
 }
 
 #[test]
-#[ignore = "today's parser misses frames at a cold start: up to 4 under a shared counter +1..+4 or +6 without the quiet line reported, 47-163 at +5 and every frame of the stream at +7 (a shared counter's steps are never learnt from an unbroken line then), and 1-2 (the first whole frame) under every count model"]
+#[ignore = "the parser misses frames at a cold start: 1-2 (the first whole frame, or a first burst ended by the quiet line, before any count has been seen continued) under every count model; up to 4 under a shared counter +6 without the quiet line reported, 47-163 at +5 and every frame of the stream at +7 (steps over 4 are never learnt from an unbroken line)"]
 fn a_cold_start_is_exact_from_the_first_whole_frame_under_every_shared_counter() {
     for step in 1..=7 {
         for quiet in [false, true] {

@@ -123,6 +123,23 @@ impl DownlinkParser {
         })
     }
 
+    /// Whether the telemetry candidate of `outer` at the front of the window ends with the
+    /// whole of a frame of another stream (its header where that frame would start, counts
+    /// aside).
+    pub(super) fn ends_with_a_frame(&self, outer: Stream) -> bool {
+        let len = Kind::Telemetry(outer).len();
+        let bytes = self.buf.as_slice().get(..len).unwrap_or(&[]);
+        Stream::ALL.iter().any(|inner| {
+            let off = len.saturating_sub(Kind::Telemetry(*inner).len());
+            *inner != outer
+                && off > 0
+                && bytes
+                    .get(off..off.saturating_add(2))
+                    .and_then(telemetry_header)
+                    == Some(*inner)
+        })
+    }
+
     /// Whether the telemetry candidate `frame` at the front of the window starts in a reply's
     /// value (the two bytes thrown away right before it are `23` and a reply code) and its
     /// tail, from where that reply ends, is a whole frame of another stream whose count (the

@@ -2,7 +2,7 @@
 //! it, and the chain of frames after it that may vouch for it ([`Walk`]).
 
 use super::class::stream_of_second;
-use super::counts::{Counts, Rel};
+use super::counts::{Counts, FIRST_STEP_MAX, Rel};
 use super::rules::{self, Chain, Need, Seen, Walk as Rule};
 use super::{DownlinkParser, IN_STEP, Lock, WINDOW};
 use crate::telemetry::{self, Downlink, Kind, Stream};
@@ -42,6 +42,11 @@ struct Walk<'a> {
     /// (Own, Restart with no step learnt) the step between the own stream's frames seen, and
     /// how many times.
     own_step: Option<(u8, u8)>,
+    /// (Own, Restart) The counts of the chain's telemetry frames, whatever their streams, from
+    /// the candidate's on: the last one, the step between each two, and how many times it
+    /// was seen (one counter shared by all streams steps every frame alike); `None` once two
+    /// steps differ.
+    shared: Option<(u8, u8, u8)>,
     /// (Exact) a frame of the chain already passed over.
     skipped: bool,
 }
@@ -75,6 +80,7 @@ impl<'a> Walk<'a> {
             pos: len,
             gap: rule.gap,
             own_step: None,
+            shared: frame.seq().map(|seq| (seq, 0, 0)),
             skipped: false,
         }
     }
@@ -212,7 +218,11 @@ impl<'a> Walk<'a> {
         // over.
         if self.parser.ends_with_a_header(next, at) {
             self.counts.take(stream, seq, false);
+            self.shared = None;
             return Continue(());
+        }
+        if self.shared_in_step(stream, seq) {
+            return Break(Ok(true));
         }
         let vouches = self.may_vouch(stream, seq)?;
         match self.counts.rel(stream, seq, at) {
@@ -230,6 +240,46 @@ impl<'a> Walk<'a> {
         }
     }
 
+    /// Whether the chain asks for frames in step to vouch for a candidate of `stream`: an Own
+    /// chain while the stream has no step learnt, a Restart chain always.
+    fn in_step_needed(&self, stream: Stream) -> bool {
+        match self.chain {
+            Chain::Restart => true,
+            Chain::Own => !self.counts.has_steps(stream),
+            _ => false,
+        }
+    }
+
+    /// (Own, Restart, while the candidate's stream has no step learnt) Whether the link of
+    /// `stream` with count `seq` makes [`IN_STEP`] steps in a row, equal and of 1 to
+    /// [`FIRST_STEP_MAX`], between the counts of the chain's telemetry frames, whatever their
+    /// streams: one counter shared by all streams, which the candidate's own stream alone
+    /// shows in uneven steps (+2 past an encoder frame).
+    fn shared_in_step(&mut self, stream: Stream, seq: u8) -> bool {
+        let Some((last, step, seen)) = self.shared else {
+            return false;
+        };
+        let own = self.own.unwrap_or(stream);
+        if !self.in_step_needed(own) {
+            return false;
+        }
+        // Only the IMU, whose frames the others come between, and not one whose tail is a
+        // whole frame of another stream: under one shared counter that frame's count (the
+        // candidate's) continues the line whether or not the candidate is real.
+        if own != Stream::Imu || seen == 0 && self.parser.ends_with_a_frame(own) {
+            self.shared = None;
+            return false;
+        }
+        let delta = seq.wrapping_sub(last);
+        if seen > 0 && delta != step || !(1..=FIRST_STEP_MAX).contains(&delta) {
+            self.shared = None;
+            return false;
+        }
+        let seen = seen.saturating_add(1);
+        self.shared = Some((seq, delta, seen));
+        seen >= IN_STEP
+    }
+
     /// Whether a link of `stream` (count `seq`) may vouch: any stream's, but only the
     /// candidate's own in an Own or Restart chain, and there, with no step learnt, only after
     /// [`IN_STEP`] frames equally spaced (sensor bytes drift slowly, and payloads repeat a
@@ -237,8 +287,7 @@ impl<'a> Walk<'a> {
     fn may_vouch(&mut self, stream: Stream, seq: u8) -> Step<bool> {
         let own_only = matches!(self.chain, Chain::Own | Chain::Restart);
         let vouches = !own_only || self.own == Some(stream);
-        let in_step = self.chain == Chain::Restart || !self.counts.has_steps(stream);
-        if !(vouches && own_only && in_step) {
+        if !(vouches && self.in_step_needed(stream)) {
             return Continue(vouches);
         }
         let delta = seq.wrapping_sub(self.counts.last(stream));

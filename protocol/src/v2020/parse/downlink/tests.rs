@@ -1198,3 +1198,43 @@ fn row9_hunting_a_count_that_is_a_headers_second_byte_needs_its_own_stream() {
     out.extend(drain_quiet(&mut p, 1));
     assert_eq!(out.get(before.len()..), Some(&after[..]), "{out:?}");
 }
+
+#[test]
+fn under_one_counter_shared_by_all_streams_the_first_imu_frame_found_hunting_comes_out() {
+    // One counter for every frame: the IMU alone steps by 1, then 2 past the encoder frame,
+    // so its own frames are not in step; the chain's frames, whatever their streams, are.
+    let mut line = Vec::new();
+    line.extend_from_slice(&imu(10, 0).encode());
+    line.extend_from_slice(&imu(11, 0).encode());
+    line.extend_from_slice(&imu(12, 0).encode());
+    line.extend_from_slice(&enc(13).encode());
+    line.extend_from_slice(&imu(14, 0).encode());
+    line.extend_from_slice(&imu(15, 0).encode());
+    let mut p = DownlinkParser::new();
+    let mut out = feed(&mut p, &line);
+    out.extend(core::iter::from_fn(|| p.poll()));
+    assert_eq!(seqs(&out), vec![10, 11, 12, 13, 14, 15]);
+    assert_eq!(p.stats().discarded, 0);
+}
+
+#[test]
+fn a_shared_counter_does_not_vouch_for_a_frame_whose_tail_is_a_whole_frame_of_another_stream() {
+    // An IMU lookalike whose last 11 bytes are a real encoder frame: under one shared counter
+    // the encoder's count continues the line, so the chain after it would be in step.
+    let encoders = enc(13).encode();
+    let mut lookalike = vec![0xFF, 0xFA, 0, 1];
+    lookalike.extend_from_slice(&encoders);
+    assert_eq!(lookalike.len(), 15);
+    // The IMU's own frames after it are not in step (+1, +1, +2); the chain's are.
+    let mut line = lookalike.clone();
+    line.extend_from_slice(&imu(14, 0).encode());
+    line.extend_from_slice(&imu(15, 0).encode());
+    line.extend_from_slice(&enc(16).encode());
+    line.extend_from_slice(&imu(17, 0).encode());
+    line.extend_from_slice(&imu(18, 0).encode());
+    let mut p = DownlinkParser::new();
+    let mut out = feed(&mut p, &line);
+    out.extend(core::iter::from_fn(|| p.poll()));
+    assert!(!out.contains(&Downlink::Imu(Imu::read(lookalike.first_chunk().unwrap()))));
+    assert_eq!(seqs(&out), vec![14, 15, 16, 17, 18]);
+}
