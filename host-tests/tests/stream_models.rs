@@ -15,9 +15,8 @@ const SEED: u64 = 99;
 /// Frames per row.
 const FRAMES: usize = 3_000;
 
-/// Count models every row runs under: those of the sweep, and shared counters stepping by 3
-/// and by 6 (steps the parser learns; +5 and +7 it does not learn without a quiet line: see
-/// the ignored test below).
+/// Count models every row runs under: those of the sweep, and shared counters stepping by 3,
+/// 6 and 7 (steps wider than a stream's first step may be: the frames in step vouch).
 fn count_models() -> Vec<(String, CountModel)> {
     let mut models: Vec<(String, CountModel)> = CountModel::ALL
         .iter()
@@ -25,6 +24,7 @@ fn count_models() -> Vec<(String, CountModel)> {
         .collect();
     models.push(("shared +3".to_string(), CountModel::SharedStep(3)));
     models.push(("shared +6".to_string(), CountModel::SharedStep(6)));
+    models.push(("shared +7".to_string(), CountModel::SharedStep(7)));
     models
 }
 
@@ -124,12 +124,12 @@ fn cold(counts: CountModel, quiet: bool) -> (usize, usize) {
 #[test]
 fn a_cold_start_misses_no_more_frames_than_today_and_emits_none_false() {
     for (name, counts) in count_models() {
-        // Every count model misses at most the first whole frame without the quiet line (and
-        // 2 with it, at offset 45: a first burst that ends on the quiet line); a shared
-        // counter stepping by more than 4 (+6 here) more, its steps not learnt from the line
-        // before the quiet.
-        let wide = matches!(counts, CountModel::SharedStep(step) if step > 4);
-        for (quiet, ceiling) in [(false, if wide { 4 } else { 1 }), (true, 2)] {
+        // Counts per stream or a tick miss at most the first whole frame without the quiet
+        // line, a shared counter at any step at most 2 (a first IMU frame whose tail reads as
+        // a whole frame of another stream is not vouched for by the shared steps); 2 with the
+        // quiet line (at offset 45: a first burst that the quiet line ends).
+        let shared = matches!(counts, CountModel::Shared | CountModel::SharedStep(_));
+        for (quiet, ceiling) in [(false, if shared { 2 } else { 1 }), (true, 2)] {
             let (missed, false_frames) = cold(counts, quiet);
             assert!(missed <= ceiling, "{name}, quiet {quiet}: {missed} missed");
             assert_eq!(false_frames, 0, "{name}, quiet {quiet}");
@@ -138,7 +138,7 @@ fn a_cold_start_misses_no_more_frames_than_today_and_emits_none_false() {
 }
 
 #[test]
-#[ignore = "the parser misses frames at a cold start: 1-2 (the first whole frame, or a first burst ended by the quiet line, before any count has been seen continued) under every count model; up to 4 under a shared counter +6 without the quiet line reported, 47-163 at +5 and every frame of the stream at +7 (steps over 4 are never learnt from an unbroken line)"]
+#[ignore = "the parser misses 1 or 2 frames at some cold starts under every count model: the first whole frame, or a first burst that the quiet line ends, before any count has been seen to continue (a frame of a stream not yet seen, or a reply nobody awaits, found while hunting, can be any payload's tail)"]
 fn a_cold_start_is_exact_from_the_first_whole_frame_under_every_shared_counter() {
     for step in 1..=7 {
         for quiet in [false, true] {

@@ -49,11 +49,12 @@ impl<const N: usize> Window<N> {
     /// Appends one byte if there is room at the end; `false` if not (nothing done).
     #[inline]
     pub(crate) fn push(&mut self, byte: u8) -> bool {
-        match self.bytes.get_mut(usize::from(self.end)) {
+        let end = self.end;
+        match self.bytes.get_mut(usize::from(end)) {
             Some(slot) => {
                 *slot = byte;
                 // (`end` indexes the window: no wrap.)
-                self.end = self.end.wrapping_add(1);
+                self.end = end.wrapping_add(1);
                 true
             }
             None => false,

@@ -271,7 +271,8 @@ impl<'a> Walk<'a> {
             return false;
         }
         let delta = seq.wrapping_sub(last);
-        if seen > 0 && delta != step || !(1..=FIRST_STEP_MAX).contains(&delta) {
+        let fits = (1..=FIRST_STEP_MAX).contains(&delta) || self.chain == Chain::Own && wide(delta);
+        if seen > 0 && delta != step || !fits {
             self.shared = None;
             return false;
         }
@@ -292,7 +293,15 @@ impl<'a> Walk<'a> {
         }
         let delta = seq.wrapping_sub(self.counts.last(stream));
         match self.own_step {
-            Some((step, seen)) if step == delta && seen >= IN_STEP - 1 => Continue(true),
+            // In step by more than a stream's first step may be (a shared counter stepping by
+            // 5 or more): the count will not read as continuing, the frames in step vouch.
+            Some((step, seen)) if step == delta && seen >= IN_STEP - 1 => {
+                if self.chain == Chain::Own && wide(delta) {
+                    Break(Ok(true))
+                } else {
+                    Continue(true)
+                }
+            }
             Some((step, seen)) if step == delta => {
                 self.own_step = Some((step, seen.saturating_add(1)));
                 Continue(false)
@@ -431,6 +440,12 @@ impl DownlinkParser {
         }
         Ok(false)
     }
+}
+
+/// Whether `delta` is a step wider than a stream's first step may be ([`FIRST_STEP_MAX`]) and
+/// still a step on (at most 127).
+fn wide(delta: u8) -> bool {
+    (FIRST_STEP_MAX.saturating_add(1)..=127).contains(&delta)
 }
 
 /// Not decided: `more` bytes are needed, unless the window is already full.

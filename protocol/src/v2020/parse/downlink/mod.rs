@@ -216,9 +216,10 @@ impl DownlinkParser {
         // The fast path, small enough to inline into the caller's loop: the last judgement
         // needs more bytes than this one (a frame, or a frame of the chain after it, is still
         // incomplete); nothing can be decided, so the byte is only stored.
-        if self.missing > 1 && self.buf.push(byte) {
+        let missing = self.missing;
+        if missing > 1 && self.buf.push(byte) {
             // (`missing` > 1: no wrap.)
-            self.missing = self.missing.wrapping_sub(1);
+            self.missing = missing.wrapping_sub(1);
             return None;
         }
         self.push_slow(byte)

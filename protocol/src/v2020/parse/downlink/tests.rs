@@ -1238,3 +1238,25 @@ fn a_shared_counter_does_not_vouch_for_a_frame_whose_tail_is_a_whole_frame_of_an
     assert!(!out.contains(&Downlink::Imu(Imu::read(lookalike.first_chunk().unwrap()))));
     assert_eq!(seqs(&out), vec![14, 15, 16, 17, 18]);
 }
+
+#[test]
+fn a_count_stepping_by_more_than_a_first_step_may_is_followed_from_a_cold_start() {
+    // One counter shared by all streams, +7 a frame: no step of 5 or more reads as continuing
+    // a stream's first count, so only the frames in step vouch.
+    let mut line = Vec::new();
+    let mut seqs_sent = Vec::new();
+    for (i, seq) in (10u8..).step_by(7).take(8).enumerate() {
+        if i == 3 {
+            line.extend_from_slice(&enc(seq).encode());
+        } else {
+            line.extend_from_slice(&imu(seq, 0).encode());
+        }
+        seqs_sent.push(seq);
+    }
+    let mut p = DownlinkParser::new();
+    let mut out = feed(&mut p, &line);
+    out.extend(core::iter::from_fn(|| p.poll()));
+    // Once the step of 7 is learnt, each frame comes out on its last byte.
+    assert_eq!(seqs(&out), seqs_sent);
+    assert_eq!(p.stats().discarded, 0);
+}
