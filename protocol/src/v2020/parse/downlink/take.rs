@@ -8,6 +8,16 @@ use super::rules::{self, Chain, Facts, Need, Seen, Start, Walk};
 use super::{DownlinkParser, FORGET_AFTER, Lock, MAX_DROPPED};
 use crate::telemetry::{self, Downlink, Kind, Stream};
 
+/// What row 11's shortcut ([`DownlinkParser::unawaited_reply`]) says.
+pub(super) enum Row11 {
+    /// Not before this many more bytes.
+    Wait(usize),
+    /// The reply at the front, `usize` bytes, is taken.
+    Take(Downlink, usize),
+    /// The general judgement decides.
+    Judge,
+}
+
 /// Telemetry whose count continues its stream, and nothing else known: row 1's facts.
 const ROW1: Facts = Facts {
     seen: Seen::Telemetry(Rel::Continues),
@@ -44,19 +54,30 @@ impl DownlinkParser {
                         }
                     }
                 }
-                if let Some(more) = self.unawaited_reply_waits(kind, self.buf.as_slice()) {
-                    self.wait_for(more);
-                    return None;
+                match self.unawaited_reply(kind) {
+                    Row11::Wait(more) => {
+                        self.wait_for(more);
+                        return None;
+                    }
+                    Row11::Take(reply, len) => {
+                        self.missing = 0;
+                        self.leave(Kind::Reply, len);
+                        self.drain = !self.buf.is_empty();
+                        return Some(reply);
+                    }
+                    Row11::Judge => {}
                 }
             }
         }
         self.run(false)
     }
 
-    /// Row 11's first two judgements without the general judgement: a reply nobody awaits, on
-    /// a boundary, whose next frame's header has not come yet waits for it (two bytes), and
-    /// with that header waits for the rest of that frame. `None`: anything else.
-    pub(super) fn unawaited_reply_waits(&self, kind: Kind, bytes: &[u8]) -> Option<usize> {
+    /// Row 11 without the general judgement, for a reply nobody awaits at the front of the
+    /// window on a boundary: with the next frame's header not yet whole, or its frame not yet
+    /// complete, it waits for it; with that frame whole, telemetry whose count is one learnt
+    /// step on, it is taken (the frame after it stays in the window). The decision the table
+    /// makes (asserted below); anything else is left to it.
+    pub(super) fn unawaited_reply(&self, kind: Kind) -> Row11 {
         // (What row 11 needs, whatever kind of boundary.)
         const UNAWAITED: Facts = Facts {
             seen: Seen::Reply {
@@ -71,38 +92,38 @@ impl DownlinkParser {
                 rules::decide(Start::Tentative, UNAWAITED),
             ),
             (
-                (
-                    11,
-                    Need::Chain(Walk {
-                        chain: Chain::Exact,
-                        gap: 0,
-                        ..
-                    })
-                ),
-                (
-                    11,
-                    Need::Chain(Walk {
-                        chain: Chain::Exact,
-                        gap: 0,
-                        ..
-                    })
-                )
+                (11, Need::Chain(Walk { chain: Chain::Exact, gap: 0, .. })),
+                (11, Need::Chain(Walk { chain: Chain::Exact, gap: 0, .. }))
             )
         ));
-        if kind != Kind::Reply || self.lock == Lock::Hunting {
-            return None;
+        let bytes = self.buf.as_slice();
+        let len = kind.len();
+        if kind != Kind::Reply || self.lock == Lock::Hunting || self.expect == bytes.get(1).copied()
+        {
+            return Row11::Judge;
         }
-        let code = bytes.get(1).copied()?;
-        if self.expect == Some(code) {
-            return None;
+        let (Some(head), Some(next)) = (bytes.get(..len), bytes.get(len..)) else {
+            return Row11::Judge;
+        };
+        let [first, second, ..] = *next else {
+            return if next.is_empty() { Row11::Wait(2) } else { Row11::Judge };
+        };
+        let Some(next_kind) = Kind::from_header(first, second) else {
+            return Row11::Judge;
+        };
+        let next_len = next_kind.len();
+        if next.len() < next_len {
+            return Row11::Wait(next_len.saturating_sub(next.len()));
         }
-        match bytes.get(kind.len()..)? {
-            [] => Some(2),
-            [first, second] => {
-                let next = Kind::from_header(*first, *second)?;
-                Some(next.len().saturating_sub(2)).filter(|n| *n > 0)
+        let continues = match (next_kind, next.last()) {
+            (Kind::Telemetry(stream), Some(&seq)) if next.len() == next_len => {
+                self.counts.learnt_step(stream, seq).is_some()
             }
-            _ => None,
+            _ => false,
+        };
+        match Downlink::read(Kind::Reply, head) {
+            Some(reply) if continues => Row11::Take(reply, len),
+            _ => Row11::Judge,
         }
     }
 
