@@ -99,6 +99,17 @@ fn judge<D: Direction>(stats: &mut Stats, frame: &[u8]) -> bool {
     false
 }
 
+/// What [`Framer::take_frame`] found, before the frame is decoded (decoded in one place, into
+/// the caller's frame: no copy of it on the way out).
+enum Step<'a> {
+    /// A frame where it lies in the caller's slice.
+    InSlice(&'a [u8]),
+    /// A frame of this length at the front of the bytes held.
+    Held(usize),
+    /// Every byte taken, no frame.
+    Nothing,
+}
+
 /// Where the rules stopped in a run of bytes.
 enum Scan {
     /// A frame taken: where it starts, and the offset just past it.
@@ -118,7 +129,7 @@ fn scan<D: Direction, const N: usize>(stats: &mut Stats, bytes: &[u8]) -> Scan {
             return Scan::Rest(bytes.len());
         };
         add(&mut stats.discarded, skip);
-        at = at.saturating_add(skip);
+        at = at.wrapping_add(skip);
         let candidate = rest.get(skip..).unwrap_or(&[]);
         let Some(&code) = candidate.get(1) else {
             return Scan::Rest(at);
@@ -128,12 +139,12 @@ fn scan<D: Direction, const N: usize>(stats: &mut Stats, bytes: &[u8]) -> Scan {
                 return Scan::Rest(at);
             };
             if judge::<D>(stats, frame) {
-                return Scan::Frame(at, at.saturating_add(need));
+                return Scan::Frame(at, at.wrapping_add(need));
             }
         }
         // Not a frame: one may begin at the next 7B.
         add(&mut stats.discarded, 1);
-        at = at.saturating_add(1);
+        at = at.wrapping_add(1);
     }
 }
 
@@ -207,20 +218,20 @@ impl<const N: usize> Framer<N> {
     /// inlines into a caller's loop is only the common case.
     #[inline(never)]
     fn push_rest<D: Direction>(&mut self, byte: u8) -> Option<D::Frame> {
-        if self.len == 0 {
+        let need = if self.len == 0 {
             self.start(byte);
-            return None;
-        }
-        if !self.settled {
+            None
+        } else if !self.settled {
             self.append(byte);
-            return self.settle::<D>(0);
-        }
-        if self.len == 1 {
+            self.settle::<D>(0)
+        } else if self.len == 1 {
             self.code::<D>(byte);
-            return None;
-        }
-        self.append(byte);
-        self.judge_held::<D>()
+            None
+        } else {
+            self.append(byte);
+            self.judge_held::<D>()
+        }?;
+        self.decode_held::<D>(need)
     }
 
     /// A frame among the bytes held, if they are not settled.
@@ -228,7 +239,8 @@ impl<const N: usize> Framer<N> {
         if self.settled {
             return None;
         }
-        self.settle::<D>(0)
+        let need = self.settle::<D>(0)?;
+        self.decode_held::<D>(need)
     }
 
     /// The line was quiet: whatever is held is the start of a frame cut short (a frame's bytes
@@ -240,12 +252,22 @@ impl<const N: usize> Framer<N> {
 
     /// Takes bytes from the front of `bytes` until a frame comes out (a frame whole in them is
     /// checked and decoded where it lies); `bytes` keeps the rest. `None`: every byte taken.
+    #[inline]
     pub(super) fn take_frame<D: Direction>(&mut self, bytes: &mut &[u8]) -> Option<D::Frame> {
-        // First what is held: settled, then completed from the front of `bytes`.
+        match self.step::<D>(bytes) {
+            Step::InSlice(frame) => D::decode(frame),
+            Step::Held(need) => self.decode_held::<D>(need),
+            Step::Nothing => None,
+        }
+    }
+
+    /// The work of [`take_frame`](Self::take_frame): what is held first (settled, then
+    /// completed from the front of `bytes`), then straight from the slice.
+    fn step<'a, D: Direction>(&mut self, bytes: &mut &'a [u8]) -> Step<'a> {
         loop {
             if !self.settled {
-                if let found @ Some(_) = self.settle::<D>(0) {
-                    return found;
+                if let Some(need) = self.settle::<D>(0) {
+                    return Step::Held(need);
                 }
             }
             if self.len == 0 {
@@ -253,36 +275,56 @@ impl<const N: usize> Framer<N> {
             }
             if self.last == 0 {
                 // A lone 7B: the next byte is its code.
-                let (&byte, rest) = bytes.split_first()?;
+                let Some((&byte, rest)) = bytes.split_first() else {
+                    return Step::Nothing;
+                };
                 *bytes = rest;
                 self.code::<D>(byte);
                 continue;
             }
             let wanted = self.last.saturating_add(1).saturating_sub(self.len);
-            let (part, rest) = bytes.split_at_checked(wanted).unwrap_or((bytes, &[]));
+            let Some((part, rest)) = bytes.split_at_checked(wanted) else {
+                // Not enough to complete it.
+                self.extend(bytes);
+                *bytes = &[];
+                return Step::Nothing;
+            };
             *bytes = rest;
             self.extend(part);
-            if self.len <= self.last {
-                return None;
-            }
-            if let found @ Some(_) = self.judge_held::<D>() {
-                return found;
+            if let Some(need) = self.judge_held::<D>() {
+                return Step::Held(need);
             }
         }
-        // Nothing held: straight from the slice.
         match scan::<D, N>(&mut self.stats, bytes) {
             Scan::Frame(start, end) => {
                 let frame = bytes.get(start..end).unwrap_or(&[]);
                 *bytes = bytes.get(end..).unwrap_or(&[]);
-                D::decode(frame)
+                Step::InSlice(frame)
             }
             Scan::Rest(at) => {
-                self.extend(bytes.get(at..).unwrap_or(&[]));
-                self.settle_held::<D>();
+                let rest = bytes.get(at..).unwrap_or(&[]);
+                self.extend(rest);
+                self.settle_on::<D>(rest.get(1).copied());
                 *bytes = &[];
-                None
+                Step::Nothing
             }
         }
+    }
+
+    /// The frame of `need` bytes at the front of the bytes held, taken: the bytes after it, if
+    /// any, stay held, not yet settled. Out of line: every way out of the bytes held ends here.
+    #[inline(never)]
+    fn decode_held<D: Direction>(&mut self, need: usize) -> Option<D::Frame> {
+        let found = D::decode(self.buf.get(..need).unwrap_or(&[]));
+        if need < self.len {
+            self.keep_from(need);
+            self.settled = false;
+        } else {
+            self.len = 0;
+            self.settled = true;
+        }
+        self.last = 0;
+        found
     }
 
     /// Nothing held (a byte may follow).
@@ -298,6 +340,7 @@ impl<const N: usize> Framer<N> {
     }
 
     /// A lone `7B` held: `byte` is its code.
+    #[inline]
     fn code<D: Direction>(&mut self, byte: u8) {
         if let Some(need) = D::len_of(byte).filter(|n| *n <= N) {
             self.append(byte);
@@ -310,65 +353,62 @@ impl<const N: usize> Framer<N> {
         }
     }
 
-    /// Judges the candidate held, whole: the frame, or one found among its bytes after its 7B.
-    fn judge_held<D: Direction>(&mut self) -> Option<D::Frame> {
-        let need = self.last.saturating_add(1);
-        let frame = self.buf.get(..need).unwrap_or(&[]);
-        if judge::<D>(&mut self.stats, frame) {
-            let found = D::decode(frame);
-            self.taken(need);
-            return found;
+    /// Judges the candidate held, whole: the frame (its length; it is at the front), or one
+    /// found among its bytes after its 7B.
+    #[inline]
+    fn judge_held<D: Direction>(&mut self) -> Option<usize> {
+        let need = self.last.wrapping_add(1);
+        if judge::<D>(&mut self.stats, self.buf.get(..need).unwrap_or(&[])) {
+            return Some(need);
         }
         add(&mut self.stats.discarded, 1);
         self.settle::<D>(1)
     }
 
-    /// The rules over the bytes held from `from` on: a frame found among them (the bytes after
-    /// it are held, not yet settled), or none (what is held then is settled).
-    fn settle<D: Direction>(&mut self, from: usize) -> Option<D::Frame> {
+    /// The rules over the bytes held from `from` on: a frame found among them, moved to the
+    /// front (its length; to be taken by [`decode_held`](Self::decode_held)), or none (what is
+    /// held then is settled).
+    fn settle<D: Direction>(&mut self, from: usize) -> Option<usize> {
         let held = self.buf.get(from..self.len).unwrap_or(&[]);
         match scan::<D, N>(&mut self.stats, held) {
             Scan::Frame(start, end) => {
-                let found = D::decode(held.get(start..end).unwrap_or(&[]));
-                self.taken(from.saturating_add(end));
-                found
+                self.keep_from(from.wrapping_add(start));
+                Some(end.wrapping_sub(start))
             }
             Scan::Rest(at) => {
-                self.keep_from(from.saturating_add(at));
+                self.keep_from(from.wrapping_add(at));
                 self.settle_held::<D>();
                 None
             }
         }
     }
 
-    /// A frame taken from the first `end` bytes held: the bytes after it, if any, are held, not
-    /// yet settled.
-    fn taken(&mut self, end: usize) {
-        if end < self.len {
-            self.keep_from(end);
-            self.settled = false;
-        } else {
-            self.len = 0;
-            self.settled = true;
-        }
-        self.last = 0;
-    }
-
     /// The bytes held are a lone `7B` or a candidate not yet whole, or nothing: where its
     /// last byte will be.
     fn settle_held<D: Direction>(&mut self) {
-        let code = self.buf.get(..self.len).and_then(|held| held.get(1));
+        let code = self
+            .buf
+            .get(..self.len)
+            .and_then(|held| held.get(1))
+            .copied();
+        self.settle_on::<D>(code);
+    }
+
+    /// As [`settle_held`](Self::settle_held), with the code held (if any) as `code`.
+    fn settle_on<D: Direction>(&mut self, code: Option<u8>) {
         self.last = code
-            .and_then(|code| D::len_of(*code))
+            .and_then(D::len_of)
             .map_or(0, |need| need.saturating_sub(1));
         self.settled = true;
     }
 
     /// Forgets the bytes held before `from`: the rest moved to the front, a byte at a time (a
-    /// rare path; `copy_within` would link a `memmove` of 1.5 KiB into a firmware that had
-    /// none).
+    /// rare path, reached from several, so out of line; `copy_within` would link a `memmove`
+    /// of 1.5 KiB into a firmware that had none).
+    #[inline(never)]
     fn keep_from(&mut self, from: usize) {
         let len = self.len.min(N);
+        let from = from.min(len);
         for (to, at) in (from..len).enumerate() {
             if let Some(byte) = self.buf.get(at).copied() {
                 if let Some(slot) = self.buf.get_mut(to) {
@@ -376,7 +416,7 @@ impl<const N: usize> Framer<N> {
                 }
             }
         }
-        self.len = len.saturating_sub(from);
+        self.len = len.wrapping_sub(from);
     }
 
     /// Holds one byte more. Room is always left: a candidate is judged once whole, and what
@@ -385,7 +425,7 @@ impl<const N: usize> Framer<N> {
     fn append(&mut self, byte: u8) {
         if let Some(slot) = self.buf.get_mut(self.len) {
             *slot = byte;
-            self.len = self.len.saturating_add(1);
+            self.len = self.len.wrapping_add(1);
         } else {
             add(&mut self.stats.discarded, 1);
         }
@@ -394,13 +434,15 @@ impl<const N: usize> Framer<N> {
     /// Holds `bytes` after the bytes held (at most the room left: a candidate's missing bytes,
     /// or the start of one, always fit).
     fn extend(&mut self, bytes: &[u8]) {
-        let room = self.buf.get_mut(self.len..).unwrap_or(&mut []);
-        let mut added = 0usize;
-        for (slot, byte) in room.iter_mut().zip(bytes) {
-            *slot = *byte;
-            added = added.saturating_add(1);
+        let len = self.len.min(N);
+        let n = bytes.len().min(N.wrapping_sub(len));
+        // Both of length `n`: the copy cannot fail.
+        if let (Some(room), Some(part)) =
+            (self.buf.get_mut(len..len.wrapping_add(n)), bytes.get(..n))
+        {
+            room.copy_from_slice(part);
+            self.len = len.wrapping_add(n);
         }
-        self.len = self.len.saturating_add(added);
     }
 
     /// Holds nothing.

@@ -41,11 +41,10 @@ impl Direction for BoardToMaster {
         Downlink::len_of(code)
     }
     #[inline]
-    fn accepts(bytes: &[u8]) -> bool {
-        // Any code with a length is a frame's: telemetry, or a reply to a readback.
-        bytes
-            .get(1)
-            .is_some_and(|code| Downlink::len_of(*code) == Some(bytes.len()))
+    fn accepts(_: &[u8]) -> bool {
+        // A candidate is as long as its code says, and every code with a length is a frame's:
+        // telemetry, or a reply to a readback (`Downlink::from_frame` decodes any).
+        true
     }
     fn decode(bytes: &[u8]) -> Option<Downlink> {
         Downlink::from_frame(bytes)
