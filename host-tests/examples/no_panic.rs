@@ -9,6 +9,7 @@
 //! cargo build --profile no-panic -p chassis-host-tests --features no-panic-proof --example no_panic
 //! ```
 
+use chassis_protocol::v1::{self, Parser as _};
 use chassis_protocol::{
     Command, CommandBytes, Downlink, DownlinkBytes, DownlinkParser, UplinkParser, Velocity,
 };
@@ -43,6 +44,50 @@ fn uplink_push_slice<'a>(
     parser: &mut UplinkParser,
     bytes: &'a [u8],
 ) -> (Option<Command>, &'a [u8]) {
+    parser.push_slice(bytes)
+}
+
+#[no_panic]
+fn v1_downlink_push(parser: &mut v1::DownlinkParser, byte: u8) -> Option<v1::Downlink> {
+    parser.push(byte)
+}
+
+#[no_panic]
+fn v1_downlink_poll(parser: &mut v1::DownlinkParser) -> Option<v1::Downlink> {
+    parser.poll()
+}
+
+#[no_panic]
+fn v1_downlink_push_slice<'a>(
+    parser: &mut v1::DownlinkParser,
+    bytes: &'a [u8],
+) -> (Option<v1::Downlink>, &'a [u8]) {
+    parser.push_slice(bytes)
+}
+
+#[no_panic]
+fn v1_downlink_take_frame(
+    parser: &mut v1::DownlinkParser,
+    bytes: &mut &[u8],
+) -> Option<v1::Downlink> {
+    parser.take_frame(bytes)
+}
+
+#[no_panic]
+fn v1_downlink_quiet(parser: &mut v1::DownlinkParser) -> Option<v1::Downlink> {
+    v1::Parser::quiet(parser, 5)
+}
+
+#[no_panic]
+fn v1_uplink_push(parser: &mut v1::UplinkParser, byte: u8) -> Option<v1::Command> {
+    parser.push(byte)
+}
+
+#[no_panic]
+fn v1_uplink_push_slice<'a>(
+    parser: &mut v1::UplinkParser,
+    bytes: &'a [u8],
+) -> (Option<v1::Command>, &'a [u8]) {
     parser.push_slice(bytes)
 }
 
@@ -87,6 +132,25 @@ fn main() {
         rest = later;
     }
     let (_, _) = uplink_push_slice(&mut up, &input);
+    let mut v1_down = v1::DownlinkParser::new();
+    let mut v1_up = v1::UplinkParser::new();
+    for b in &input {
+        frames += usize::from(v1_downlink_push(&mut v1_down, *b).is_some());
+        frames += usize::from(v1_downlink_poll(&mut v1_down).is_some());
+        frames += usize::from(v1_uplink_push(&mut v1_up, *b).is_some());
+    }
+    let mut rest = &input[..];
+    while !rest.is_empty() {
+        let (frame, later) = v1_downlink_push_slice(&mut v1_down, rest);
+        frames += usize::from(frame.is_some());
+        rest = later;
+    }
+    let mut rest = &input[..];
+    while v1_downlink_take_frame(&mut v1_down, &mut rest).is_some() {
+        frames += 1;
+    }
+    frames += usize::from(v1_downlink_quiet(&mut v1_down).is_some());
+    let (_, _) = v1_uplink_push_slice(&mut v1_up, &input);
     frames += usize::from(downlink_idle(&mut down).is_some());
     for window in input.windows(15).take(64) {
         if let Some(t) = decode_telemetry(window) {

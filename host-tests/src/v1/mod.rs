@@ -1,7 +1,8 @@
 //! The board's v1.0.0 firmware (`7B … BCC 7D`): a model of its board → master stream, the line
 //! it crosses, and the scoring of `chassis_protocol::v1::DownlinkParser` against what was sent,
 //! with what the XOR checksum is expected to miss and a plausibility check beside it. Used by
-//! the example `v1_sweep` (`cargo xtask sweep`), the test `v1_streams` and the benchmark.
+//! the example `v1_sweep` (`cargo xtask sweep`), the tests `v1_streams` and `v1_parsers` and the
+//! benchmark.
 //!
 //! * [`board`]: 32-byte telemetry at 22 Hz with a driven chassis' values, a readback reply now
 //!   and then, the line idle in between.
@@ -11,11 +12,14 @@
 //!   place past the BCC, or made by the framing.
 //! * [`expect`]: the probability that bit errors slip past the BCC, worked out.
 //! * [`plausible`](mod@plausible): telemetry values a chassis cannot report.
+//! * [`reference`]: the v1.0.0 parsers' rules written plainly, to check the crate's parsers
+//!   against (`tests/v1_parsers.rs`).
 
 pub mod board;
 pub mod expect;
 pub mod line;
 pub mod plausible;
+pub mod reference;
 pub mod score;
 
 pub use board::{Board, Gap, SentFrame, Stream};

@@ -1,11 +1,17 @@
-//! Byte-at-a-time parsers of v1.0.0 frames, one per direction. Each holds at most one frame's
+//! Streaming parsers of v1.0.0 frames, one per direction, fed a byte at a time (`push`) or a
+//! slice at a time (`push_slice`, `frames()` of [`Parser`]). Each holds at most one frame's
 //! bytes. A frame is taken when it is whole and its start, end and BCC check; otherwise its
-//! first byte is dropped and the next `7B` inside what is held is tried (so a frame that
-//! began inside a damaged one is never lost). A byte that cannot start a frame is discarded at
-//! once: the parser is never stuck, and never holds more than 32 bytes.
+//! first byte is dropped and the next `7B` inside it is tried (so a frame that began inside a
+//! damaged one is never lost). A byte that cannot start a frame is discarded at once: the
+//! parser is never stuck, and never holds more than 32 bytes. The rules, and how each way in
+//! follows them at little cost, are in [`framer`]; either way, and in any chunking, the frames
+//! and the counters are the same.
 
-use super::{COMMAND_LEN, Command, Downlink, END, START, TELEMETRY_LEN, bcc};
+mod framer;
+
+use super::{COMMAND_LEN, Command, Downlink, TELEMETRY_LEN};
 use crate::stream::Parser;
+use framer::{Direction, Framer};
 
 /// What a parser has seen.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -24,121 +30,43 @@ pub struct Stats {
     pub discarded: u32,
 }
 
-/// Moves `buf[from..len]` to the front, byte by byte: no `memmove` and no panic path (a
-/// firmware's link-time no-panic proof must see none).
-fn shift_down<const N: usize>(buf: &mut [u8; N], from: usize, len: usize) {
-    for (to, at) in (from..len.min(N)).enumerate() {
-        if let Some(byte) = buf.get(at).copied() {
-            if let Some(slot) = buf.get_mut(to) {
-                *slot = byte;
-            }
-        }
-    }
-}
-
-/// The bytes of at most one frame, and the rules to find one.
+/// Board → master: telemetry (32 bytes) and replies (14).
 #[derive(Clone, Copy, Debug)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-struct Framer<const N: usize> {
-    buf: [u8; N],
-    len: usize,
-    stats: Stats,
+struct BoardToMaster;
+
+impl Direction for BoardToMaster {
+    type Frame = Downlink;
+    #[inline]
+    fn len_of(code: u8) -> Option<usize> {
+        Downlink::len_of(code)
+    }
+    #[inline]
+    fn accepts(_: &[u8]) -> bool {
+        // A candidate is as long as its code says, and every code with a length is a frame's:
+        // telemetry, or a reply to a readback (`Downlink::from_frame` decodes any).
+        true
+    }
+    fn decode(bytes: &[u8]) -> Option<Downlink> {
+        Downlink::from_frame(bytes)
+    }
 }
 
-impl<const N: usize> Framer<N> {
-    const fn new() -> Self {
-        Framer {
-            buf: [0; N],
-            len: 0,
-            stats: Stats {
-                frames: 0,
-                bad_checksum: 0,
-                bad_end: 0,
-                refused: 0,
-                discarded: 0,
-            },
-        }
-    }
+/// Master → board: commands (14 bytes).
+#[derive(Clone, Copy, Debug)]
+struct MasterToBoard;
 
-    /// Drops the first `n` held bytes.
-    fn drop_front(&mut self, n: usize) {
-        let n = n.min(self.len);
-        shift_down(&mut self.buf, n, self.len);
-        self.len = self.len.saturating_sub(n);
-        self.stats.discarded = self
-            .stats
-            .discarded
-            .saturating_add(u32::try_from(n).unwrap_or(u32::MAX));
+impl Direction for MasterToBoard {
+    type Frame = Command;
+    #[inline]
+    fn len_of(code: u8) -> Option<usize> {
+        Command::is_code(code).then_some(COMMAND_LEN)
     }
-
-    /// Takes `byte` in (room is always left by [`next`](Self::next)).
-    fn push(&mut self, byte: u8) {
-        if self.len >= N {
-            // Not reached: `next` leaves fewer than N bytes held. Kept safe all the same.
-            self.drop_front(1);
-        }
-        if let Some(slot) = self.buf.get_mut(self.len) {
-            *slot = byte;
-            self.len = self.len.saturating_add(1);
-        }
+    fn accepts(bytes: &[u8]) -> bool {
+        // A readback request with a payload, say.
+        Command::decode(bytes).is_ok()
     }
-
-    /// The next whole, checked frame among the held bytes: its length (its bytes are
-    /// `buf[..len]`; [`consume`](Self::consume) them once used). `len_of` gives a frame's
-    /// length from its code byte (`None`: no frame has this code).
-    fn next(
-        &mut self,
-        len_of: impl Fn(u8) -> Option<usize>,
-        accept: impl Fn(&[u8]) -> bool,
-    ) -> Option<usize> {
-        loop {
-            // A frame starts with 7B.
-            let skip = self
-                .buf
-                .get(..self.len)
-                .and_then(|held| held.iter().position(|b| *b == START))
-                .unwrap_or(self.len);
-            if skip > 0 {
-                self.drop_front(skip);
-            }
-            let code = *self.buf.get(..self.len)?.get(1)?;
-            let Some(need) = len_of(code).filter(|n| *n <= N) else {
-                self.drop_front(1);
-                continue;
-            };
-            if self.len < need {
-                return None;
-            }
-            let frame = self.buf.get(..need)?;
-            let (body, tail) = frame.split_at(need.saturating_sub(2));
-            match tail {
-                [sum, END] if *sum == bcc(body) => {
-                    if accept(frame) {
-                        self.stats.frames = self.stats.frames.saturating_add(1);
-                        return Some(need);
-                    }
-                    self.stats.refused = self.stats.refused.saturating_add(1);
-                }
-                [_, END] => self.stats.bad_checksum = self.stats.bad_checksum.saturating_add(1),
-                _ => self.stats.bad_end = self.stats.bad_end.saturating_add(1),
-            }
-            // Not a frame: a frame may start at the next 7B inside it.
-            self.drop_front(1);
-        }
-    }
-
-    /// The line was quiet: whatever is held is the start of a frame cut short (a frame's bytes
-    /// come back to back), never to be completed by what comes next. Thrown away, counted.
-    fn quiet(&mut self) {
-        let held = self.len;
-        self.drop_front(held);
-    }
-
-    /// Forgets the `n` bytes of a frame taken (not counted as discarded).
-    fn consume(&mut self, n: usize) {
-        let n = n.min(self.len);
-        shift_down(&mut self.buf, n, self.len);
-        self.len = self.len.saturating_sub(n);
+    fn decode(bytes: &[u8]) -> Option<Command> {
+        Command::decode(bytes).ok()
     }
 }
 
@@ -183,31 +111,26 @@ impl DownlinkParser {
     /// Takes one byte; the frame it completes, if any. A byte can complete at most one frame;
     /// call [`poll`](Self::poll) after a frame until `None` (a frame found inside a damaged one
     /// may follow).
+    #[inline]
     pub fn push(&mut self, byte: u8) -> Option<Downlink> {
-        self.framer.push(byte);
-        self.poll()
+        self.framer.push::<BoardToMaster>(byte)
     }
 
     /// A frame already whole among the held bytes, if any.
     pub fn poll(&mut self) -> Option<Downlink> {
-        let len = self
-            .framer
-            .next(Downlink::len_of, |f| Downlink::decode(f).is_ok())?;
-        let frame = Downlink::decode(self.framer.buf.get(..len).unwrap_or(&[])).ok();
-        self.framer.consume(len);
-        frame
+        self.framer.poll::<BoardToMaster>()
     }
 
     /// What it has seen.
     #[must_use]
     pub const fn stats(&self) -> Stats {
-        self.framer.stats
+        self.framer.stats()
     }
 
     /// Bytes held, waiting for the rest of a frame.
     #[must_use]
     pub const fn buffered(&self) -> usize {
-        self.framer.len
+        self.framer.len()
     }
 
     /// The line has been quiet (no byte for longer than any gap inside a frame: 2 ms on a
@@ -247,29 +170,24 @@ impl UplinkParser {
     /// Takes one byte; the command it completes, if any (then [`poll`](Self::poll) until
     /// `None`).
     pub fn push(&mut self, byte: u8) -> Option<Command> {
-        self.framer.push(byte);
-        self.poll()
+        self.framer.push::<MasterToBoard>(byte)
     }
 
     /// A command already whole among the held bytes, if any.
     pub fn poll(&mut self) -> Option<Command> {
-        let len_of = |code: u8| Command::is_code(code).then_some(COMMAND_LEN);
-        let len = self.framer.next(len_of, |f| Command::decode(f).is_ok())?;
-        let command = Command::decode(self.framer.buf.get(..len).unwrap_or(&[])).ok();
-        self.framer.consume(len);
-        command
+        self.framer.poll::<MasterToBoard>()
     }
 
     /// Bytes held, waiting for the rest of a frame.
     #[must_use]
     pub const fn buffered(&self) -> usize {
-        self.framer.len
+        self.framer.len()
     }
 
     /// What it has seen.
     #[must_use]
     pub const fn stats(&self) -> Stats {
-        self.framer.stats
+        self.framer.stats()
     }
 
     /// The line has been quiet: as [`DownlinkParser::quiet`].
@@ -280,6 +198,7 @@ impl UplinkParser {
 
 impl Parser for DownlinkParser {
     type Frame = Downlink;
+    #[inline]
     fn push(&mut self, byte: u8) -> Option<Downlink> {
         DownlinkParser::push(self, byte)
     }
@@ -293,6 +212,14 @@ impl Parser for DownlinkParser {
     }
     fn buffered(&self) -> usize {
         DownlinkParser::buffered(self)
+    }
+    fn push_slice<'a>(&mut self, bytes: &'a [u8]) -> (Option<Downlink>, &'a [u8]) {
+        let mut rest = bytes;
+        let frame = self.framer.take_frame::<BoardToMaster>(&mut rest);
+        (frame, rest)
+    }
+    fn take_frame(&mut self, bytes: &mut &[u8]) -> Option<Downlink> {
+        self.framer.take_frame::<BoardToMaster>(bytes)
     }
 }
 
@@ -310,5 +237,13 @@ impl Parser for UplinkParser {
     }
     fn buffered(&self) -> usize {
         UplinkParser::buffered(self)
+    }
+    fn push_slice<'a>(&mut self, bytes: &'a [u8]) -> (Option<Command>, &'a [u8]) {
+        let mut rest = bytes;
+        let frame = self.framer.take_frame::<MasterToBoard>(&mut rest);
+        (frame, rest)
+    }
+    fn take_frame(&mut self, bytes: &mut &[u8]) -> Option<Command> {
+        self.framer.take_frame::<MasterToBoard>(bytes)
     }
 }
