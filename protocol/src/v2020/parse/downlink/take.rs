@@ -92,8 +92,22 @@ impl DownlinkParser {
                 rules::decide(Start::Tentative, UNAWAITED),
             ),
             (
-                (11, Need::Chain(Walk { chain: Chain::Exact, gap: 0, .. })),
-                (11, Need::Chain(Walk { chain: Chain::Exact, gap: 0, .. }))
+                (
+                    11,
+                    Need::Chain(Walk {
+                        chain: Chain::Exact,
+                        gap: 0,
+                        ..
+                    })
+                ),
+                (
+                    11,
+                    Need::Chain(Walk {
+                        chain: Chain::Exact,
+                        gap: 0,
+                        ..
+                    })
+                )
             )
         ));
         let bytes = self.buf.as_slice();
@@ -106,7 +120,11 @@ impl DownlinkParser {
             return Row11::Judge;
         };
         let [first, second, ..] = *next else {
-            return if next.is_empty() { Row11::Wait(2) } else { Row11::Judge };
+            return if next.is_empty() {
+                Row11::Wait(2)
+            } else {
+                Row11::Judge
+            };
         };
         let Some(next_kind) = Kind::from_header(first, second) else {
             return Row11::Judge;
