@@ -25,10 +25,13 @@ const ICOUNT_MACHINES: [IcountMachine; 2] = [
     },
 ];
 
-/// What the parser may not grow past on the telemetry mix, in instructions per byte on the
-/// Cortex-M4 (measured 76 through `push` when it was set): a regression guard; the goal (25)
-/// is not met.
-pub const ICOUNT_CEILING_M4: u64 = 90;
+/// What the 2020 parser may not grow past on the telemetry mix, in instructions per byte on the
+/// Cortex-M4 through `push`: a regression guard. Set at 90 (measured 76); lowered to 50 when it
+/// measured 44.4 (row 11 without the general judgement). The goal (30, stretch 25) is not met.
+pub const ICOUNT_CEILING_M4: u64 = 50;
+
+/// The 2020 parser's goal on the telemetry mix, in instructions per byte on the Cortex-M4.
+pub const ICOUNT_GOAL_M4: u64 = 30;
 
 /// What the v1.0.0 board → master parser may not grow past on its board's stream, in
 /// instructions per byte on the Cortex-M4 through `push`: the parser issue's goal, 25. Measured
@@ -183,8 +186,8 @@ fn print_row(
 /// The Cortex-M4's figures (`m4`) against the goals and the ceilings.
 fn print_verdicts(m4: IcountM4) {
     println!(
-        "\ngoals (2020 parser): ≤ 25 instr/B on the telemetry mix on Cortex-M4: {}; a saturated link under 1 % of a 48 MHz Cortex-M0+: see the last column",
-        met(m4.parser_2020 <= 25)
+        "\ngoals (2020 parser): ≤ {ICOUNT_GOAL_M4} instr/B on the telemetry mix on Cortex-M4 (stretch 25): {}; a saturated link under 1 % of a 48 MHz Cortex-M0+: see the last column",
+        met(m4.parser_2020 <= ICOUNT_GOAL_M4)
     );
     println!(
         "ceilings on Cortex-M4, telemetry mix, `push`: 2020 {} instr/B (a regression guard), {}; v1.0.0 {} instr/B (its goal), {}",
