@@ -153,16 +153,18 @@ fn follow_turn(driver: &mut Board, deci: i32) -> Result<String, String> {
             "{:.1}° of {shown:.1}°",
             f64::from(deci - left) / 10.0
         ));
-        if !driver.core().turning() {
-            break Ok(format!(
-                "turned {shown:.1}° in {:.1} s",
-                start.elapsed().as_secs_f64()
-            ));
-        }
+        // The ending first: a read it cut short, or the stop it brought (its cancel of the
+        // turn), leaves the core no longer turning, which is not the turn done.
         if ending::ended().is_some() {
             break Err(format!(
                 "the {shown:.1}° turn was sent, {:.1}° of it left",
                 f64::from(left) / 10.0
+            ));
+        }
+        if !driver.core().turning() {
+            break Ok(format!(
+                "turned {shown:.1}° in {:.1} s",
+                start.elapsed().as_secs_f64()
             ));
         }
         if driver.core().failsafe_stops() > 0 {
