@@ -45,3 +45,18 @@ fn spliced_reply_after_cut() {
     };
     assert_eq!(check_recovery(&splice), Ok(()));
 }
+
+/// `spliced`, CI run of 2026-11-27: a dropout of 15 bytes cut a battery frame (its first
+/// battery frame on the line) so that it ended on the next IMU frame's count byte, one on from
+/// the IMU frame before it. The chain's frames of every stream then looked in step (one counter
+/// shared by all streams): a frame of a stream with no count yet is no evidence of it.
+#[test]
+fn spliced_battery_cut_onto_the_next_imu_count() {
+    let splice = Splice {
+        seed: 576_742_270_229_809_212,
+        at: 0,
+        cut: 239,
+        garbage: &[],
+    };
+    assert_eq!(check_recovery(&splice), Ok(()));
+}

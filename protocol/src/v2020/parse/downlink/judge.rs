@@ -276,7 +276,14 @@ impl<'a> Walk<'a> {
             self.shared = None;
             return false;
         }
-        let seen = seen.saturating_add(1);
+        // A frame of a stream with no count yet keeps the steps but is no evidence: a damaged
+        // frame's tail can end on another stream's count byte (a battery frame cut by a
+        // dropout, ending on the next IMU frame's count).
+        let seen = if self.counts.knows(stream) {
+            seen.saturating_add(1)
+        } else {
+            seen
+        };
         self.shared = Some((seq, delta, seen));
         seen >= IN_STEP
     }
@@ -304,6 +311,12 @@ impl<'a> Walk<'a> {
             }
             Some((step, seen)) if step == delta => {
                 self.own_step = Some((step, seen.saturating_add(1)));
+                Continue(false)
+            }
+            // Out of step: the chain fails, unless the chain's frames of every stream are
+            // still in step (one counter shared by all streams): then only they may vouch.
+            Some(_) if self.shared.is_some() => {
+                self.own_step = Some((0, 0));
                 Continue(false)
             }
             Some(_) => Break(Ok(false)),
