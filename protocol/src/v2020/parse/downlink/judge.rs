@@ -80,7 +80,7 @@ impl<'a> Walk<'a> {
             pos: len,
             gap: rule.gap,
             own_step: None,
-            shared: frame.seq().map(|seq| (seq, 0, 0)),
+            shared: None,
             skipped: false,
         }
     }
