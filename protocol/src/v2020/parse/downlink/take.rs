@@ -8,6 +8,38 @@ use super::rules::{self, Chain, Facts, Need, Seen, Start, Walk};
 use super::{DownlinkParser, FORGET_AFTER, Lock, MAX_DROPPED};
 use crate::telemetry::{self, Downlink, Kind, Stream};
 
+// What row 11 needs, whatever kind of boundary: what its shortcut assumes.
+const UNAWAITED: Facts = Facts {
+    seen: Seen::Reply {
+        awaited: false,
+        clean: true,
+    },
+    ..ROW1
+};
+const _: () = assert!(matches!(
+    (
+        rules::decide(Start::Locked, UNAWAITED),
+        rules::decide(Start::Tentative, UNAWAITED),
+    ),
+    (
+        (
+            11,
+            Need::Chain(Walk {
+                chain: Chain::Exact,
+                gap: 0,
+                ..
+            })
+        ),
+        (
+            11,
+            Need::Chain(Walk {
+                chain: Chain::Exact,
+                gap: 0,
+                ..
+            })
+        )
+    )
+));
 /// What row 11's shortcut ([`DownlinkParser::unawaited_reply`]) says.
 pub(super) enum Row11 {
     /// Not before this many more bytes.
@@ -78,38 +110,6 @@ impl DownlinkParser {
     /// step on, it is taken (the frame after it stays in the window). The decision the table
     /// makes (asserted below); anything else is left to it.
     pub(super) fn unawaited_reply(&self, kind: Kind) -> Row11 {
-        // (What row 11 needs, whatever kind of boundary.)
-        const UNAWAITED: Facts = Facts {
-            seen: Seen::Reply {
-                awaited: false,
-                clean: true,
-            },
-            ..ROW1
-        };
-        const _: () = assert!(matches!(
-            (
-                rules::decide(Start::Locked, UNAWAITED),
-                rules::decide(Start::Tentative, UNAWAITED),
-            ),
-            (
-                (
-                    11,
-                    Need::Chain(Walk {
-                        chain: Chain::Exact,
-                        gap: 0,
-                        ..
-                    })
-                ),
-                (
-                    11,
-                    Need::Chain(Walk {
-                        chain: Chain::Exact,
-                        gap: 0,
-                        ..
-                    })
-                )
-            )
-        ));
         let bytes = self.buf.as_slice();
         let len = kind.len();
         if kind != Kind::Reply || self.lock == Lock::Hunting || self.expect == bytes.get(1).copied()
