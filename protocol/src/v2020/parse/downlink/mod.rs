@@ -32,10 +32,8 @@
 //! hunting; *Tentative*: right after a quiet line; *Hunting*: anywhere. A *chain* is the frames
 //! right after the candidate, back to back, reaching one whose count continues its stream
 //! ([`rules::Chain`] says which links count). With no step learnt, a stream's first frame found
-//! while hunting needs three more of its stream in step (equal steps from its count on), or,
-//! an IMU frame, the chain's next three frames of streams with a count, of any streams, in
-//! step (one counter shared by all streams), unless its tail reads as a whole frame of another
-//! stream.
+//! while hunting needs three more of its stream in step (equal steps from its count on), a
+//! step wider than [`counts::FIRST_STEP_MAX`] included.
 //!
 //! * A rejected candidate costs exactly **one** byte, its first: a real frame a false
 //!   candidate overlapped is still found.
