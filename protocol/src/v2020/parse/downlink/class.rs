@@ -240,12 +240,14 @@ pub(super) fn stream_of_second(second: u8) -> Option<Stream> {
     telemetry_header(&[sync, second])
 }
 /// The stream whose telemetry header `pair` is, if it is one.
+#[inline]
 pub(super) fn telemetry_header(pair: &[u8]) -> Option<Stream> {
-    match pair {
-        [a, b] => match Kind::from_header(*a, *b) {
-            Some(Kind::Telemetry(stream)) => Some(stream),
-            _ => None,
-        },
+    // (The headers themselves, not `Kind::from_header`: a reply's header needs a table
+    // lookup, a telemetry header two compares.)
+    match *pair {
+        [a, b] if [a, b] == telemetry::Imu::HEADER => Some(Stream::Imu),
+        [a, b] if [a, b] == telemetry::Encoders::HEADER => Some(Stream::Encoders),
+        [a, b] if [a, b] == telemetry::Battery::HEADER => Some(Stream::Battery),
         _ => None,
     }
 }

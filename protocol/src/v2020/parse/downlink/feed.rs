@@ -15,7 +15,11 @@ impl DownlinkParser {
     pub(super) fn push_slow(&mut self, byte: u8) -> Option<Downlink> {
         if !self.drain {
             if self.missing == 1 {
-                // This byte completes the frame at the front of the window.
+                // This byte completes what was missing: a frame's header right after a frame
+                // row 1 took, or the frame at the front of the window.
+                if self.buf.len() == 1 {
+                    return self.push_header(byte);
+                }
                 if self.buf.push(byte) {
                     return self.complete();
                 }
@@ -24,6 +28,23 @@ impl DownlinkParser {
                 // (most bytes while hunting through noise: kept apart so that it costs little).
                 self.discard_run(&[byte]);
                 return None;
+            }
+        }
+        self.push_decide(byte)
+    }
+
+    /// [`push_slow`](Self::push_slow) for a byte that may end a frame's header, its first byte
+    /// alone in the window (right after a frame row 1 took): a whole header waits for the rest
+    /// of its frame, as the judgement would; anything else goes to
+    /// [`push_decide`](Self::push_decide).
+    #[inline(never)]
+    fn push_header(&mut self, byte: u8) -> Option<Downlink> {
+        if let [first] = *self.buf.as_slice() {
+            if let Some(wait) = Kind::from_header(first, byte).and_then(header_wait) {
+                if self.buf.push(byte) {
+                    self.missing = wait;
+                    return None;
+                }
             }
         }
         self.push_decide(byte)
@@ -111,4 +132,15 @@ impl DownlinkParser {
             bytes = bytes.get(taken..).unwrap_or(&[]);
         }
     }
+}
+
+/// What a frame of `kind` whose two header bytes alone are in the window leaves
+/// [`missing`](DownlinkParser::missing): the bytes up to its last, as the judgement would wait
+/// for them ([`DownlinkParser::wait_for`]). `None` for a frame that a wait of one byte would
+/// leave to the judgement (none does: every frame is longer than three bytes).
+#[inline]
+fn header_wait(kind: Kind) -> Option<u8> {
+    u8::try_from(kind.len().checked_sub(2)?)
+        .ok()
+        .filter(|n| *n > 1)
 }

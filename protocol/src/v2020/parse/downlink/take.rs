@@ -66,6 +66,28 @@ impl DownlinkParser {
     /// is judged. The same decision either way: a shortcut, not a rule.
     #[inline(never)]
     pub(super) fn complete(&mut self) -> Option<Downlink> {
+        // Row 1, the common case, without the general bookkeeping (kept apart from the rest:
+        // a small function is cheap to enter).
+        let bytes = self.buf.as_slice();
+        if let (&[first, second, ..], Some(&seq)) = (bytes, bytes.last()) {
+            if let Some(stream) = telemetry_header(&[first, second]) {
+                if Kind::Telemetry(stream).len() == bytes.len() {
+                    if let Some(step) = self.row1_step(stream, seq) {
+                        if let Some(frame) = Downlink::read_telemetry(stream, bytes) {
+                            self.take_learnt(stream, step, seq);
+                            return Some(frame);
+                        }
+                    }
+                }
+            }
+        }
+        self.complete_judged()
+    }
+
+    /// [`complete`](Self::complete) past row 1: a frame still incomplete waits, row 11's
+    /// shortcut, else the general judgement.
+    #[inline(never)]
+    fn complete_judged(&mut self) -> Option<Downlink> {
         let bytes = self.buf.as_slice();
         if let [first, second, ..] = *bytes {
             if let Some(kind) = Kind::from_header(first, second) {
@@ -74,17 +96,6 @@ impl DownlinkParser {
                 if let Some(more) = kind.len().checked_sub(bytes.len()).filter(|n| *n > 0) {
                     self.wait_for(more);
                     return None;
-                }
-                // Row 1, the common case, without the general bookkeeping.
-                if let (Kind::Telemetry(stream), true, Some(&seq)) =
-                    (kind, kind.len() == bytes.len(), bytes.last())
-                {
-                    if let Some(step) = self.row1_step(stream, seq) {
-                        if let Some(frame) = Downlink::read_telemetry(stream, bytes) {
-                            self.take_learnt(stream, step, seq);
-                            return Some(frame);
-                        }
-                    }
                 }
                 match self.unawaited_reply(kind) {
                     Row11::Wait(more) => {
