@@ -26,9 +26,10 @@ const ICOUNT_MACHINES: [IcountMachine; 2] = [
 ];
 
 /// What the 2020 parser may not grow past on the telemetry mix, in instructions per byte on the
-/// Cortex-M4 through `push`: a regression guard. Set at 90 (measured 76); lowered to 50 when it
-/// measured 44.4 (row 11 without the general judgement). The goal (30, stretch 25) is not met.
-pub const ICOUNT_CEILING_M4: u64 = 50;
+/// Cortex-M4 through `push`: a regression guard, a little above what it measures (40.8, with
+/// row 1, row 11 and a frame's header taken without the general judgement). The goal (30,
+/// stretch 25) is not met.
+pub const ICOUNT_CEILING_M4: u64 = 44;
 
 /// The 2020 parser's goal on the telemetry mix, in instructions per byte on the Cortex-M4.
 pub const ICOUNT_GOAL_M4: u64 = 30;
