@@ -12,12 +12,15 @@ use std::time::{Duration, Instant};
 pub fn poll_for<K: Spoken>(driver: &mut HostDriver<K>, ms: u64) -> Result<(), String> {
     let until = Instant::now() + Duration::from_millis(ms);
     while Instant::now() < until && ending::ended().is_none() {
-        if driver
-            .poll()
-            .map_err(|e| stopping::explain(driver, e))?
-            .is_none()
-        {
-            std::thread::sleep(Duration::from_millis(2));
+        match driver.poll() {
+            Ok(Some(_)) => {}
+            Ok(None) => std::thread::sleep(Duration::from_millis(2)),
+            // An ending that came during the poll cut its read short (the port's waits look at
+            // it): that is the ending, not a link error, and the caller says what of its work
+            // the ending left (a turn's angle, a calibration's time), as when the ending comes
+            // between two polls.
+            Err(_) if ending::ended().is_some() => break,
+            Err(e) => return Err(stopping::explain(driver, e)),
         }
     }
     Ok(())
