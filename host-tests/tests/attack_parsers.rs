@@ -1882,3 +1882,235 @@ fn v1_huge_inputs() {
         }
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// The 2020 parser on a board's line with damage: deep states
+// ---------------------------------------------------------------------------------------------
+
+/// The board's bursts as the driver's calls, damaged: each byte substituted, dropped or
+/// followed by an inserted one with probability `rate` (in millionths), and now and then a
+/// dropout of 32 bytes; the quiet line reported after a burst when `quiet`.
+fn damaged_ops(bursts: &[Burst], seed: u64, rate: u64, quiet: bool) -> Vec<Op> {
+    let mut rng = Rng(seed | 1);
+    let mut ops = vec![Op::Quiet(5)];
+    let mut dropout = 0usize;
+    for b in bursts {
+        if let Some(r) = b.read {
+            ops.push(Op::Expect(Some(r)));
+        }
+        let mut bytes = Vec::new();
+        for f in &b.frames {
+            for x in f.encode().as_ref() {
+                if dropout > 0 {
+                    dropout -= 1;
+                    continue;
+                }
+                match rng.below(1_000_000) {
+                    n if n < rate => bytes.push(*x ^ (1 + rng.below(255) as u8)),
+                    n if n < 2 * rate => {}
+                    n if n < 3 * rate => {
+                        bytes.push(*x);
+                        bytes.push([0xFF, 0xFA, 0x23, rng.next() as u8][rng.below(4) as usize]);
+                    }
+                    n if n < 3 * rate + rate / 8 => dropout = 32,
+                    _ => bytes.push(*x),
+                }
+            }
+        }
+        if !bytes.is_empty() {
+            ops.push(Op::Bytes(bytes));
+        }
+        if quiet {
+            ops.push(Op::Quiet(8));
+        }
+    }
+    ops
+}
+
+#[test]
+fn v2020_damaged_board_line_any_chunking() {
+    let strategy = (
+        any::<u64>(),
+        proptest::sample::select(vec![0u64, 1_000, 10_000, 50_000]),
+        any::<bool>(),
+        proptest::sample::select(vec![1u8, 2, 3]),
+        plan(),
+    );
+    runner(cases(60), 21)
+        .run(&strategy, |(seed, rate, quiet, step, plan)| {
+            let bursts = board(150, seed, step, [seed as u8, 3, 250]);
+            let ops = damaged_ops(&bursts, seed, rate, quiet);
+            same_as_reference::<DownlinkParser>(&ops, &plan, DRAIN)
+        })
+        .unwrap();
+}
+
+#[test]
+fn v2020_counts_forgotten_after_a_long_stretch_without_frames() {
+    // Locked on counts near 10, then junk that starts no frame or false headers, of any length,
+    // then the board again with its counts far on: nothing false, and the frames come back.
+    for len in [0usize, 1, 17, 100, 239, 240, 241, 600] {
+        for junk_byte in [0x00u8, 0xFF, 0x23] {
+            let head: Vec<Downlink> = (5..=12).map(|s| imu(s).into()).collect();
+            let tail: Vec<Downlink> = (0..20u8).map(|i| imu(150 + i).into()).collect();
+            let mut line = bytes_of(&head);
+            line.extend(std::iter::repeat_n(junk_byte, len));
+            line.extend_from_slice(&bytes_of(&tail));
+            let mut p = DownlinkParser::new();
+            let mut got = quiet(&mut p, 5);
+            got.extend(p.frames(&line));
+            got.extend(quiet(&mut p, 5));
+            let sent: Vec<Downlink> = head.iter().chain(&tail).copied().collect();
+            assert!(is_subsequence(&got, &sent), "junk {junk_byte:02X} × {len}");
+            assert!(
+                got.ends_with(&tail[4..]),
+                "junk {junk_byte:02X} × {len}: {:?}",
+                got.iter().filter_map(Downlink::seq).collect::<Vec<_>>()
+            );
+        }
+    }
+}
+
+#[test]
+fn v2020_a_burst_that_starts_mid_frame() {
+    // Locked; a frame cut by a quiet line after `cut` bytes; the next burst starts with the
+    // rest of it (an overrun at the quiet) or with a new frame. Nothing false comes out, and
+    // the frames after come out.
+    for cut in 1..15 {
+        for rest in [true, false] {
+            let head: Vec<Downlink> = (1..=5).map(|s| imu(s).into()).collect();
+            let cut_frame = Imu {
+                accel: [-6, -5, -4],
+                gyro: [-4, -5, -6],
+                seq: 6,
+            }
+            .encode();
+            let tail: Vec<Downlink> = (7..=14).map(|s| imu(s).into()).collect();
+            let mut p = DownlinkParser::new();
+            let mut got = quiet(&mut p, 5);
+            got.extend(p.frames(&bytes_of(&head)));
+            got.extend(p.frames(&cut_frame[..cut]));
+            got.extend(quiet(&mut p, 3));
+            if rest {
+                got.extend(p.frames(&cut_frame[cut..]));
+            }
+            got.extend(p.frames(&bytes_of(&tail)));
+            got.extend(quiet(&mut p, 5));
+            let sent: Vec<Downlink> = head.iter().chain(&tail).copied().collect();
+            assert!(
+                is_subsequence(&got, &sent),
+                "cut {cut} rest {rest}: {got:?}"
+            );
+            assert!(got.ends_with(&tail[2..]), "cut {cut} rest {rest}: {got:?}");
+        }
+    }
+}
+
+/// A board whose payloads are header bytes only (`FF`, `FA`..`FC`, `23`, reply codes).
+fn hostile_board(ticks: usize, seed: u64) -> Vec<Burst> {
+    let mut bursts = board(ticks, seed, 1, [0, 0, 0]);
+    let mut rng = Rng(seed ^ 0x5555);
+    let alphabet = [0xFFu8, 0xFA, 0xFB, 0xFC, 0x23, 0x01, 0x06, 0x0C, 0x20];
+    let mut v = || {
+        i16::from_be_bytes([
+            alphabet[rng.below(9) as usize],
+            alphabet[rng.below(9) as usize],
+        ])
+    };
+    for b in &mut bursts {
+        for f in &mut b.frames {
+            match f {
+                Downlink::Imu(x) => {
+                    x.accel = [v(), v(), v()];
+                    x.gyro = [v(), v(), v()];
+                }
+                Downlink::Encoders(x) => x.ticks = [v(), v(), v(), v()],
+                Downlink::Battery(x) => {
+                    x.centivolts = v() as u16;
+                    x.percent = v() as u16;
+                }
+                Downlink::Reply(_) => {}
+            }
+        }
+    }
+    bursts
+}
+
+#[test]
+fn v2020_hostile_payloads_clean_line_no_false_frame() {
+    // Payloads of header bytes only, on a clean line, the quiet reported or not: no frame the
+    // board did not send, and nearly all that it did.
+    for seed in 1..=6u64 {
+        for quiet_reported in [true, false] {
+            let bursts = hostile_board(1_000, seed);
+            let sent = all_frames(&bursts);
+            let ops = driver_ops(&bursts, quiet_reported);
+            let run = Run::<DownlinkParser>::script(&ops, &[(64, Way::Frames, false)], DRAIN);
+            assert!(run.broken.is_none(), "{:?}", run.broken);
+            assert!(
+                is_subsequence(&run.frames, &sent),
+                "seed {seed} quiet {quiet_reported}: a frame not sent"
+            );
+            let recall = run.frames.len() as f64 / sent.len() as f64;
+            assert!(
+                recall > 0.99,
+                "seed {seed} quiet {quiet_reported}: {} of {}",
+                run.frames.len(),
+                sent.len()
+            );
+        }
+    }
+}
+
+#[test]
+fn v2020_cold_start_in_hostile_payloads() {
+    // Starting anywhere in a clean line whose payloads are header bytes only (`FF`, `FA`..`FC`,
+    // `23` and reply codes), no reply awaited: no frame the board did not send (README: "0
+    // false frames on clean streams from any start").
+    for seed in 77..=80u64 {
+        let bursts = hostile_board(40, seed);
+        let sent: Vec<Downlink> = all_frames(&bursts)
+            .into_iter()
+            .filter(|f| !matches!(f, Downlink::Reply(_)))
+            .collect();
+        let line = bytes_of(&sent);
+        for start in 0..150 {
+            let mut p = DownlinkParser::new();
+            let mut got: Vec<Downlink> = p.frames(&line[start..]).collect();
+            got.extend(quiet(&mut p, 5));
+            assert!(
+                is_subsequence(&got, &sent),
+                "seed {seed} start {start}: {:?}",
+                got.iter().find(|g| !sent.contains(g))
+            );
+        }
+    }
+}
+
+#[test]
+#[ignore = "found by the outside attack: started mid-frame with a read awaited, the frame's tail 23 01 .. is taken as the reply"]
+fn v2020_cold_start_awaiting_a_reply_takes_no_frames_tail() {
+    // README: "its parser delivers 0 false frames on clean streams from any start". A clean
+    // line of IMU frames 6..12; IMU 6 has gyro X = 35 and gyro Y = 256, so its last six bytes
+    // are `23 01 00 00 02 06`: `#`, the max-speed reply code, four bytes. A parser that starts
+    // anywhere in IMU 6's bytes 1..=9 with a read of the maximum speed awaited (the master asked
+    // right before it started listening, or right after a `reset`) emits
+    // `Reply { code: 0x01, value: 0x0000_0206 }`, a value the board never sent, then IMU 7..12.
+    // With no reply awaited the same starts emit IMU 7..12 only.
+    let first = Imu {
+        accel: [0, 1, 16_384],
+        gyro: [35, 256, 2],
+        seq: 6,
+    };
+    let mut sent: Vec<Downlink> = vec![first.into()];
+    sent.extend((7..=12).map(|s| Downlink::Imu(imu(s))));
+    let line = bytes_of(&sent);
+    assert_eq!(&line[9..15], [0x23, 0x01, 0x00, 0x00, 0x02, 0x06]);
+    for start in 1..=9 {
+        let mut p = DownlinkParser::new();
+        p.expect_reply(Some(Register::MaxSpeed));
+        let mut got: Vec<Downlink> = p.frames(&line[start..]).collect();
+        got.extend(quiet(&mut p, 5));
+        assert!(is_subsequence(&got, &sent), "start {start}: {:?}", got[0]);
+    }
+}
