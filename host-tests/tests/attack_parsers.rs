@@ -1395,6 +1395,30 @@ fn v1_every_intact_frame_comes_out() {
                 }
                 // Then bytes that start nothing, so every candidate is whole by the end.
                 line.extend_from_slice(&[0x00; 32]);
+                // A candidate begun before an intact frame can end on its `7D` with a BCC that
+                // matches (1 in 256): a false frame by framing, which no rule can tell. Such
+                // lines are left out.
+                let starts: Vec<usize> = {
+                    let mut at = 0;
+                    let mut v = Vec::new();
+                    for (f, junk, cut) in &pieces {
+                        let n = f.encode().as_ref().len();
+                        at += junk.len() + cut % n;
+                        v.push(at);
+                        at += n;
+                    }
+                    v
+                };
+                for i in 0..line.len() {
+                    let Some(n) = line.get(i + 1).and_then(|c| v1::Downlink::len_of(*c)) else {
+                        continue;
+                    };
+                    if line[i] == v1::START && !starts.contains(&i) {
+                        if let Some(c) = line.get(i..i + n) {
+                            prop_assume!(v1::Downlink::decode(c).is_err());
+                        }
+                    }
+                }
                 let mut p = v1::DownlinkParser::new();
                 let got: Vec<v1::Downlink> = Parser::frames(&mut p, &line).collect();
                 prop_assert_eq!(&got, &sent);
@@ -1701,37 +1725,49 @@ fn v2020_a_false_header_right_before_a_frame_costs_one_byte() {
 }
 
 #[test]
-#[ignore = "found by the outside attack: a poll() that returns None passes judgement, so polling before expect_reply changes the frames"]
-fn v2020_poll_that_finds_nothing_changes_nothing() {
-    // `poll`: "Emits a frame that is already decided in the window, if any, without a new
-    // byte." After a quiet line, a reply `23 0C FF FF FF FF` and one byte `01`; then the master
-    // says it awaits that register, then the line goes quiet. Without a `poll` in between the
-    // reply comes out (the candidate was still waiting, and `expect_reply` re-judges it);
-    // with a `poll` that returned `None`, the 7 bytes were already thrown away (`discarded` 7,
-    // `lock()` Hunting), and nothing comes out.
+#[ignore = "found by the outside attack: push byte by byte vs push_slice/frames/poll give different frames when expect_reply follows"]
+fn v2020_the_same_bytes_then_expect_reply_any_way_fed() {
+    // After a quiet line, a reply `23 0C FF FF FF FF` and one byte `01`; then the master says
+    // it awaits that register (battery range, reply code 0x0C); then the line goes quiet.
+    // Fed with `push` a byte at a time, the candidate is still waiting when `expect_reply`
+    // comes, is judged again as awaited, and comes out. Fed with `push_slice` or `frames()`,
+    // or with `push` and one `poll()` that returns `None`, the 7 bytes are already thrown
+    // away (`discarded` 7, `lock()` Hunting) and nothing comes out. `push_slice`: "It goes
+    // through the same decisions as feeding the same bytes one at a time, so it emits the same
+    // frames in the same order"; `poll`: "Emits a frame that is already decided in the window,
+    // if any, without a new byte". (The same with `23 01 FF 23 FF FF FA` and max speed.)
     let line = [0x23, 0x0C, 0xFF, 0xFF, 0xFF, 0xFF, 0x01];
-    let run = |poll: bool| {
+    let run = |way: &str| {
         let mut p = DownlinkParser::new();
         let mut got = quiet(&mut p, 0);
-        for b in line {
-            got.extend(p.push(b));
-        }
-        if poll {
-            assert_eq!(p.poll(), None);
+        match way {
+            "push" => {
+                for b in line {
+                    got.extend(p.push(b));
+                }
+            }
+            "push, poll" => {
+                for b in line {
+                    got.extend(p.push(b));
+                }
+                got.extend(p.poll());
+            }
+            "push_slice" => {
+                let (f, rest) = p.push_slice(&line);
+                assert!(rest.is_empty());
+                got.extend(f);
+            }
+            _ => got.extend(p.frames(&line)),
         }
         p.expect_reply(Some(Register::BatteryRange));
         got.extend(quiet(&mut p, 100));
-        (got, *p.stats())
+        got
     };
-    let (without, _) = run(false);
-    assert_eq!(
-        without,
-        [Downlink::Reply(Reply::new(
-            Register::BatteryRange,
-            u32::MAX
-        ))]
-    );
-    assert_eq!(run(true), run(false));
+    let reply = Downlink::Reply(Reply::new(Register::BatteryRange, u32::MAX));
+    assert_eq!(run("push"), [reply]);
+    for way in ["push, poll", "push_slice", "frames"] {
+        assert_eq!(run(way), run("push"), "{way}");
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -2164,4 +2200,58 @@ fn v2020_awaited_reply_in_the_tail_of_a_frame_that_lost_its_first_byte() {
         let sent: Vec<Downlink> = head.iter().chain(&tail).copied().collect();
         assert_eq!(got, sent, "IMU 6 sent as {six:02X?}");
     }
+}
+
+#[test]
+fn v2020_a_frame_cut_at_a_quiet_line() {
+    // "A frame that started on a boundary and misses more than MAX_DROPPED bytes when the line
+    // goes quiet lost its tail … The parser then goes on hunting. (A byte or two missing is
+    // noise inside the frame: the next burst is aligned.)"
+    // (From its header on: a lone `FF` is no frame begun yet.)
+    let max_dropped = chassis_protocol::parse::downlink::MAX_DROPPED;
+    for missing in 1..14 {
+        let mut p = DownlinkParser::new();
+        quiet(&mut p, 5);
+        let head: Vec<Downlink> = (1..=4).map(|s| imu(s).into()).collect();
+        let mut got: Vec<Downlink> = p.frames(&bytes_of(&head)).collect();
+        assert_eq!(p.lock(), Lock::Locked);
+        got.extend(p.frames(&imu(5).encode()[..15 - missing]));
+        got.extend(quiet(&mut p, 3));
+        assert_eq!(got, head, "missing {missing}");
+        let want = if missing > max_dropped {
+            Lock::Hunting
+        } else {
+            Lock::Tentative
+        };
+        // (Locked stays as good as Tentative: the next byte starts a frame.)
+        assert!(
+            p.lock() == want || (want == Lock::Tentative && p.lock() == Lock::Locked),
+            "missing {missing}: {:?}",
+            p.lock()
+        );
+        assert_eq!(p.buffered(), 0, "missing {missing}");
+        // The next burst, aligned, comes out either way.
+        let tail: Vec<Downlink> = (6..=10).map(|s| imu(s).into()).collect();
+        let mut after: Vec<Downlink> = p.frames(&bytes_of(&tail)).collect();
+        after.extend(quiet(&mut p, 5));
+        assert_eq!(after, tail, "missing {missing}");
+    }
+}
+
+#[test]
+fn v1_bytes_that_start_nothing_are_not_held() {
+    let mut p = v1::DownlinkParser::new();
+    for b in 0..=255u8 {
+        if b != v1::START {
+            assert_eq!(p.push(b), None);
+            assert_eq!(p.buffered(), 0);
+        }
+    }
+    assert_eq!(p.stats().discarded, 255);
+    // A `7B` followed by a code no frame of this direction has: both gone at once.
+    p.push(0x7B);
+    assert_eq!(p.buffered(), 1);
+    p.push(0x25);
+    assert_eq!(p.buffered(), 0);
+    assert_eq!(p.stats().discarded, 257);
 }
