@@ -206,9 +206,13 @@ impl Parser for DownlinkParser {
         DownlinkParser::poll(self)
     }
     fn quiet(&mut self, _ms: u32) -> Option<Downlink> {
-        // A frame's bytes come back to back: the start of one cut short by the quiet goes.
+        // A frame already whole among the bytes held comes out first; then, a frame's bytes
+        // coming back to back, the start of one cut short by the quiet goes.
+        if let Some(frame) = DownlinkParser::poll(self) {
+            return Some(frame);
+        }
         DownlinkParser::quiet(self);
-        DownlinkParser::poll(self)
+        None
     }
     fn buffered(&self) -> usize {
         DownlinkParser::buffered(self)
@@ -232,8 +236,11 @@ impl Parser for UplinkParser {
         UplinkParser::poll(self)
     }
     fn quiet(&mut self, _ms: u32) -> Option<Command> {
+        if let Some(frame) = UplinkParser::poll(self) {
+            return Some(frame);
+        }
         UplinkParser::quiet(self);
-        UplinkParser::poll(self)
+        None
     }
     fn buffered(&self) -> usize {
         UplinkParser::buffered(self)
