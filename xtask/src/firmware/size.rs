@@ -81,8 +81,11 @@ pub mod budget {
     /// (444 B: the frames in step whatever their streams, a whole frame in the candidate's
     /// tail) and took row 11 without the general judgement (308 B, 2.4 instructions a byte
     /// less on the Cortex-M4): 12 848 B; 13 256 B once row 1 and a frame's header took short
-    /// ways of their own (408 B for 3.2 instructions a byte less on the Cortex-M4).
-    pub const PROTOCOL_CEILING: u64 = 13 * 1024;
+    /// ways of their own (408 B for 3.2 instructions a byte less on the Cortex-M4). Raised to
+    /// 13.5 KiB for what an outside attack found (152 B: `poll` and the slice path judge at
+    /// the bytes `push` judges at; an awaited reply that may be a frame's tail is not taken):
+    /// 13 408 B.
+    pub const PROTOCOL_CEILING: u64 = 13 * 1024 + 512;
     /// Hardware boards' budgets, by directory: (flash, static RAM), a little above what each
     /// measured when it was added (a regression guard; the ESP32-C3's RAM counts the 3 KiB of
     /// code esp-hal runs from its SRAM).

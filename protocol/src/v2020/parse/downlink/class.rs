@@ -2,7 +2,7 @@
 //! frame can raise (inside a frame rejected on a boundary, a header for its count byte, a frame
 //! nested in it, in a reply's value); and where it starts ([`Start`]). Nothing here decides.
 
-use super::counts::Rel;
+use super::counts::{FIRST_STEP_MAX, Rel};
 use super::rules::{Facts, Seen, Start};
 use super::{DownlinkParser, Lock};
 use crate::telemetry::{self, Downlink, Kind, Stream};
@@ -22,6 +22,7 @@ impl DownlinkParser {
         };
         match (frame, frame.kind(), frame.seq()) {
             (Downlink::Reply(reply), ..) => {
+                facts.shadow = hunting && (self.in_shadow() || self.may_be_a_frames_tail());
                 facts.seen = Seen::Reply {
                     awaited: self.expect == Some(reply.code),
                     clean: !holds_a_frame_start(reply.encode().get(2..).unwrap_or(&[])),
@@ -40,6 +41,31 @@ impl DownlinkParser {
             _ => {}
         }
         facts
+    }
+
+    /// While hunting, about the reply at the front of the window: whether it may be the tail
+    /// of a telemetry frame whose start was lost or damaged (a payload can hold `23` and a
+    /// reply code). It is when it and the bytes thrown away right before it (since the last
+    /// frame taken or quiet line, or since the start) fit in a frame of a stream, and the next
+    /// frame, of that stream, continues from the reply's last byte read as that frame's count.
+    fn may_be_a_frames_tail(&self) -> bool {
+        let len = Kind::Reply.len();
+        let buf = self.buf.as_slice();
+        let (Some(&last), Some(next)) = (buf.get(len.wrapping_sub(1)), buf.get(len..)) else {
+            return false;
+        };
+        let Some(stream) = next.get(..2).and_then(telemetry_header) else {
+            return false;
+        };
+        let (Some(&count), true) = (
+            next.get(stream.seq_at()),
+            usize::from(self.thrown.before_len).saturating_add(len)
+                <= Kind::Telemetry(stream).len(),
+        ) else {
+            return false;
+        };
+        let delta = count.wrapping_sub(last);
+        (1..=FIRST_STEP_MAX).contains(&delta) || self.counts.is_step(stream, delta)
     }
 
     /// Row 14's suspicion about the telemetry candidate `frame` (count `rel`) at the front of

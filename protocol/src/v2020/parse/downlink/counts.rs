@@ -142,6 +142,11 @@ impl Counts {
             .is_some_and(|steps| steps.iter().any(|s| s.hits > 0))
     }
 
+    /// Whether `delta` is one of `stream`'s learnt steps.
+    pub fn is_step(&self, stream: Stream, delta: u8) -> bool {
+        self.step_of(stream.index(), delta).is_some()
+    }
+
     /// Which of stream `i`'s learnt steps is `delta`, if one is.
     #[inline]
     fn step_of(&self, i: usize, delta: u8) -> Option<usize> {

@@ -25,7 +25,7 @@
 //! | 2 | a boundary | the awaited reply, no header in its value | on its last byte |
 //! | 3 | a boundary | the awaited reply, a header in its value | with a header after it |
 //! | 11 | a boundary | a reply nobody awaits | the next frame's count exactly (or the quiet line) |
-//! | 10 | Hunting | the awaited reply, not inside a rejected frame | a chain or the quiet line, no second reply of its code |
+//! | 10 | Hunting | the awaited reply, not inside a rejected frame or a frame's tail | a chain or the quiet line, no second reply of its code |
 //! | 12 | Hunting | any other reply | never |
 //!
 //! *Locked*: right after a frame taken on a boundary; *Resynced*: right after one found while

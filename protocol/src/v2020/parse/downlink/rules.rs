@@ -53,6 +53,9 @@ pub struct Facts {
     pub seen: Seen,
     /// It starts inside a frame rejected on a boundary: there, a continuing count and the
     /// awaited code are no evidence (a damaged frame's payload ends where the next starts).
+    /// For a reply found hunting, also: it may be the tail of a telemetry frame whose start was
+    /// lost or damaged (it and the bytes thrown away before it fit in one, and the next frame,
+    /// of that stream, continues from its last byte read as a count).
     pub shadow: bool,
     /// Its count would continue (or be near) another stream's too.
     pub other_fits: bool,
@@ -193,7 +196,7 @@ pub const fn decide(start: Start, f: Facts) -> (u8, Need) {
         Seen::Reply { awaited: true, .. } if !hunting => (3, Follow),
         // 11. On a boundary, a reply nobody awaits.
         Seen::Reply { awaited: false, .. } if !hunting => (11, EXACT),
-        // 10. Hunting, the awaited reply, not inside a rejected frame.
+        // 10. Hunting, the awaited reply, not inside a rejected frame or a frame's tail.
         Seen::Reply { awaited: true, .. } if !f.shadow => (10, VERIFY_ONCE),
         // 12. Hunting, any other reply (`23` and a code in a damaged frame's payload ends
         //     where the next frame starts).

@@ -550,6 +550,37 @@ fn row10_an_awaited_reply_whose_chain_holds_another_with_its_code_is_not_the_ans
 }
 
 #[test]
+fn row10_an_awaited_reply_that_may_be_a_frames_tail_is_not_taken() {
+    // IMU frames whose gyro X is 35 and gyro Y 256 end in `23 01 00 00 02 <count>`: the
+    // maximum speed's reply code and a value. Started listening inside such a frame (or after
+    // it lost its header), with that read awaited, the parser cannot tell that tail from the
+    // reply: what was thrown away before it and the reply fit in one IMU frame, and the next IMU
+    // frame continues from the reply's last byte read as a count. It is not taken (the master
+    // asks again); the IMU frames after it are.
+    let frame = |seq| Imu {
+        accel: [0, 1, 16_384],
+        gyro: [35, 256, 2],
+        seq,
+    };
+    let mut line = Vec::new();
+    for seq in 6..=10 {
+        line.extend_from_slice(&frame(seq).encode());
+    }
+    assert_eq!(line.get(9..14), Some(&[0x23, 0x01, 0x00, 0x00, 0x02][..]));
+    for start in 1..=9 {
+        let mut p = DownlinkParser::new();
+        p.expect_reply(Some(Register::MaxSpeed));
+        let mut out = feed(&mut p, line.get(start..).unwrap_or(&[]));
+        out.extend(drain_quiet(&mut p, 5));
+        assert!(
+            out.iter().all(|f| f.kind() != Kind::Reply),
+            "start {start}: {out:?}"
+        );
+        assert_eq!(seqs(&out), [7, 8, 9, 10], "start {start}");
+    }
+}
+
+#[test]
 fn row11_a_reply_nobody_awaits_ending_in_the_next_headers_first_byte_lost_a_byte_itself() {
     let mut p = locked();
     // The reply `23 01 00 00 01 F4` (maximum speed 500) lost its last byte; IMU 4 and 5 follow
