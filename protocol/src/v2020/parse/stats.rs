@@ -18,9 +18,13 @@ pub struct DownlinkStats {
     pub lock_losses: u32,
     /// Times a hunting parser found a frame and became aligned again.
     pub resyncs: u32,
-    /// Per stream (IMU, encoders, battery): frames whose count did not follow the previous one.
+    /// Per stream (IMU, encoders, battery): frames whose count did not follow the previous one
+    /// where the line lost something since (bytes thrown away, or quiet as long as the
+    /// stream's period). On a line that lost nothing, every byte was a frame taken: a count
+    /// further on is the board's own step, learnt, not a gap.
     pub gaps: [u32; 3],
-    /// Per stream: frames missing according to the count bytes (a gap of 3 counts 2).
+    /// Per stream: frames missing according to the count bytes, where `gaps` counts (a gap of
+    /// 3 counts 2).
     pub missed: [u32; 3],
 }
 

@@ -35,8 +35,10 @@
 //! while hunting needs three more of its stream in step (equal steps from its count on), a
 //! step wider than [`counts::FIRST_STEP_MAX`] included.
 //!
-//! * A rejected candidate costs exactly **one** byte, its first: a real frame a false
-//!   candidate overlapped is still found.
+//! * A rejected candidate costs **one** byte, its first: a real frame a false candidate
+//!   overlapped is still found, but one that starts right inside a frame rejected on a
+//!   boundary, where it reads as that frame's damaged tail (row 14: a lone `FF FA` or `FF FB`
+//!   right before an IMU frame costs that frame; the frames after it come out).
 //! * **A quiet line is time, not amnesia** ([`DownlinkParser::quiet`]): it widens every count
 //!   window by the frames the time could hold; the count check never goes away.
 //! * **Steps are learnt only from a line that lost nothing** ([`counts`]).
