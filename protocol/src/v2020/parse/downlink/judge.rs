@@ -80,7 +80,7 @@ impl<'a> Walk<'a> {
             pos: len,
             gap: rule.gap,
             own_step: None,
-            shared: None,
+            shared: frame.seq().map(|seq| (seq, 0, 0)),
             skipped: false,
         }
     }
@@ -254,7 +254,7 @@ impl<'a> Walk<'a> {
     /// `stream` with count `seq` makes [`IN_STEP`] steps in a row, equal and of 1 to
     /// [`FIRST_STEP_MAX`], between the counts of the chain's telemetry frames, whatever their
     /// streams: one counter shared by all streams, which the candidate's own stream alone
-    /// shows in uneven steps (+2 past an encoder frame).
+    /// shows in uneven steps (+2 past an encoder frame). Its own stream steps first.
     fn shared_in_step(&mut self, stream: Stream, seq: u8) -> bool {
         let Some((last, step, seen)) = self.shared else {
             return false;
@@ -276,9 +276,17 @@ impl<'a> Walk<'a> {
             self.shared = None;
             return false;
         }
-        // A frame of a stream with no count yet keeps the steps but is no evidence: a damaged
-        // frame's tail can end on another stream's count byte (a battery frame cut by a
-        // dropout, ending on the next IMU frame's count).
+        // The candidate's own stream steps first, straight from the candidate (replies aside):
+        // a dropout can cut a frame of another stream so that it ends on the own stream's next
+        // count byte, that frame's header lost with it, and such a frame between the candidate
+        // and its stream's next frame would make a gap in the own stream look like the shared
+        // step, and teach the own stream twice its step.
+        if stream != own && self.own_step.is_none() {
+            self.shared = None;
+            return false;
+        }
+        // A frame of a stream with no count yet is no evidence, but keeps the steps: its count
+        // is anyone's (the same dropout can cut it onto the own stream's next count).
         let seen = if self.counts.knows(stream) {
             seen.saturating_add(1)
         } else {

@@ -1231,7 +1231,6 @@ fn row9_hunting_a_count_that_is_a_headers_second_byte_needs_its_own_stream() {
 }
 
 #[test]
-#[ignore = "the frames-in-step rule across streams is switched off: the repeatable fuzz run of spliced found it taking cut frames as evidence"]
 fn under_one_counter_shared_by_all_streams_the_first_imu_frame_found_hunting_comes_out() {
     // One counter for every frame: the IMU alone steps by 1, then 2 past the encoder frame,
     // so its own frames are not in step; the chain's frames, whatever their streams, are.
@@ -1250,7 +1249,6 @@ fn under_one_counter_shared_by_all_streams_the_first_imu_frame_found_hunting_com
 }
 
 #[test]
-#[ignore = "the frames-in-step rule across streams is switched off: the repeatable fuzz run of spliced found it taking cut frames as evidence"]
 fn a_shared_counter_does_not_vouch_for_a_frame_whose_tail_is_a_whole_frame_of_another_stream() {
     // An IMU lookalike whose last 11 bytes are a real encoder frame: under one shared counter
     // the encoder's count continues the line, so the chain after it would be in step.
@@ -1273,7 +1271,6 @@ fn a_shared_counter_does_not_vouch_for_a_frame_whose_tail_is_a_whole_frame_of_an
 }
 
 #[test]
-#[ignore = "the frames-in-step rule across streams is switched off: the repeatable fuzz run of spliced found it taking cut frames as evidence"]
 fn a_count_stepping_by_more_than_a_first_step_may_is_followed_from_a_cold_start() {
     // One counter shared by all streams, +7 a frame: no step of 5 or more reads as continuing
     // a stream's first count, so only the frames in step vouch.
