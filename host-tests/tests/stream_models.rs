@@ -125,11 +125,12 @@ fn cold(counts: CountModel, quiet: bool) -> (usize, usize) {
 fn a_cold_start_misses_no_more_frames_than_today_and_emits_none_false() {
     for (name, counts) in count_models() {
         // Counts per stream or a tick miss at most the first whole frame without the quiet
-        // line, a shared counter at any step at most 2 (a first IMU frame whose tail reads as
-        // a whole frame of another stream is not vouched for by the shared steps); 2 with the
-        // quiet line (at offset 45: a first burst that the quiet line ends).
+        // line, a shared counter at any step at most 2 on this seed (a first IMU frame whose
+        // tail reads as a whole frame of another stream, or that the line's first encoder frame
+        // follows straight, is not vouched for by the shared steps: 4 at one start on seed
+        // 424 242); 2 with the quiet line (at offset 45: a first burst that the quiet line ends).
         let shared = matches!(counts, CountModel::Shared | CountModel::SharedStep(_));
-        for (quiet, ceiling) in [(false, if shared { 8 } else { 1 }), (true, 2)] {
+        for (quiet, ceiling) in [(false, if shared { 2 } else { 1 }), (true, 2)] {
             let (missed, false_frames) = cold(counts, quiet);
             assert!(missed <= ceiling, "{name}, quiet {quiet}: {missed} missed");
             assert_eq!(false_frames, 0, "{name}, quiet {quiet}");
