@@ -61,34 +61,41 @@ fn spliced_battery_cut_onto_the_next_imu_count() {
     assert_eq!(check_recovery(&splice), Ok(()));
 }
 
-/// Found by a scan of every splice point, cut and short garbage (2026-11-27): 15 bytes cut out
-/// of the line's first encoder frame, right after the first IMU frame found while hunting, so
-/// that it ended on the next IMU frame's count byte (that frame's header lost with the cut). The
-/// chain after the IMU frame then stepped alike whatever its streams (+1 onto the cut frame,
-/// +1 onto the next IMU frame), and taking it taught the IMU a step of 2, which a line stepping
-/// by 1 never continued: the parser lost two IMU frames in four to the end. Now the
-/// candidate's own stream steps first, straight from it, before a frame of another stream keeps
-/// the steps. (The same with a byte of garbage in place of one more cut byte: CI's "splice at
-/// 60, 16 cut, 1 in".)
+/// Found by a scan of every splice point, cut and short garbage (2026-11-27; seed 34 with every
+/// garbage tried, seeds 521 and 1042 with the three of the wider scan): 15 bytes cut out of the
+/// line's first encoder frame, right after the first IMU frame found while hunting, so that it
+/// ended on the next IMU frame's count byte (that frame's header lost with the cut). The chain
+/// after the IMU frame then stepped alike whatever its streams (+1 onto the cut frame, +1 onto
+/// the next IMU frame), and taking it taught the IMU a step of 2, which a line stepping by 1
+/// never continued: the parser lost two IMU frames in four, and every encoder frame, to the
+/// end. Now the candidate's own stream steps first, straight from it, before a frame of another
+/// stream keeps the steps. (The same with a byte of garbage in place of one more cut byte:
+/// CI's "splice at 60, 16 cut, 1 in".)
 #[test]
 fn spliced_first_encoder_frame_cut_onto_the_next_imu_count() {
-    let cases: [(u16, u8, &[u8]); 12] = [
+    let every_seed: [(u16, u8, &[u8]); 6] = [
         (0, 15, &[]),
         (1, 15, &[]),
         (2, 15, &[]),
         (0, 16, &[0]),
         (1, 16, &[0]),
+        (0, 17, &[0xFF, 0xFA]),
+    ];
+    let seed_34_more: [(u16, u8, &[u8]); 6] = [
         (0, 16, &[0xFF]),
         (1, 16, &[0xFF]),
         (0, 16, &[0x23]),
         (1, 16, &[0x23]),
-        (0, 17, &[0xFF, 0xFA]),
         (0, 17, &[0xFF, 0xFB]),
         (0, 17, &[0xFF, 0xFC]),
     ];
-    for (at, cut, garbage) in cases {
+    let cases = [34, 521, 1_042]
+        .into_iter()
+        .flat_map(|seed| every_seed.map(|case| (seed, case)))
+        .chain(seed_34_more.map(|case| (34, case)));
+    for (seed, (at, cut, garbage)) in cases {
         let splice = Splice {
-            seed: 34,
+            seed,
             at,
             cut,
             garbage,
