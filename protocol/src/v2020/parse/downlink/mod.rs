@@ -33,12 +33,12 @@
 //! right after the candidate, back to back, reaching one whose count continues its stream
 //! ([`rules::Chain`] says which links count). With no step learnt, a stream's first frame found
 //! while hunting needs three more of its stream in step (equal steps from its count on), a
-//! step wider than [`counts::FIRST_STEP_MAX`] included.
+//! step wider than [`counts::FIRST_STEP_MAX`] included; an IMU frame, also the next three of
+//! any streams with a count in step (one counter shared by all), the IMU's own stepping first.
 //!
 //! * A rejected candidate costs **one** byte, its first: a real frame a false candidate
-//!   overlapped is still found, but one that starts right inside a frame rejected on a
-//!   boundary, where it reads as that frame's damaged tail (row 14: a lone `FF FA` or `FF FB`
-//!   right before an IMU frame costs that frame; the frames after it come out).
+//!   overlapped is still found, unless it starts right inside a frame rejected on a boundary
+//!   (row 14: a lone `FF FA` right before an IMU frame costs that frame).
 //! * **A quiet line is time, not amnesia** ([`DownlinkParser::quiet`]): it widens every count
 //!   window by the frames the time could hold; the count check never goes away.
 //! * **Steps are learnt only from a line that lost nothing** ([`counts`]).
