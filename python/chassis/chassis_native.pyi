@@ -422,12 +422,12 @@ class UplinkParser(
 
 @final
 class V1DownlinkParser(_Parser[Telemetry | ReadbackReply]):
-    def quiet(self) -> None: ...
+    def quiet(self) -> list[Telemetry | ReadbackReply]: ...
 
 # Its `feed` gives commands other than a body velocity as dicts of their fields (JSON-like values).
 @final
 class V1UplinkParser(_Parser[BodyVelocity | dict[str, Any]]):
-    def quiet(self) -> None: ...
+    def quiet(self) -> list[BodyVelocity | dict[str, Any]]: ...
 
 # ----- captures -----
 

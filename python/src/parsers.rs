@@ -172,10 +172,16 @@ macro_rules! v1_parser {
                 found(py, || self.inner.frames(&data).collect::<Vec<$frame>>(), $to_py)
             }
 
-            /// The line has been quiet (2 ms on a UART, 25 ms behind a USB-UART): the start of a
-            /// frame cut short is thrown away; no frame spans a quiet line.
-            fn quiet(&mut self) {
-                self.inner.quiet();
+            /// The line has been quiet (2 ms on a UART, 25 ms behind a USB-UART): the frames
+            /// whole among the bytes held; the start of a frame cut short is thrown away; no
+            /// frame spans a quiet line.
+            fn quiet(&mut self, py: Python<'_>) -> PyResult<Vec<Py<PyAny>>> {
+                let inner = &mut self.inner;
+                found(
+                    py,
+                    || core::iter::from_fn(|| inner.quiet()).collect::<Vec<$frame>>(),
+                    $to_py,
+                )
             }
 
             /// Counters: frames, bad_checksum, bad_end, refused, discarded.

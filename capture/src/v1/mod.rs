@@ -22,19 +22,24 @@ impl Generation for V1 {
         let mut placed = Placed::new(capture);
         let (mut telemetry, mut replies) = (0u32, 0u32);
         let mut parser = v1::DownlinkParser::new();
+        let mut found = |frame: v1::Downlink, end: usize| {
+            match frame {
+                v1::Downlink::Telemetry(_) => telemetry = telemetry.saturating_add(1),
+                v1::Downlink::Reply(_) => replies = replies.saturating_add(1),
+            }
+            placed.add(frame.encode().as_slice(), end, describe_v1_downlink(&frame));
+        };
         for (i, &byte) in capture.bytes.iter().enumerate() {
-            // A frame's bytes come back to back: none spans a quiet line in the time stamps.
+            // A frame's bytes come back to back: none spans a quiet line in the time stamps
+            // (a frame whole before it ends there).
             if capture.gap_before(i).is_some() {
-                parser.quiet();
+                while let Some(frame) = parser.quiet() {
+                    found(frame, i);
+                }
             }
             let mut next = parser.push(byte);
             while let Some(frame) = next {
-                match frame {
-                    v1::Downlink::Telemetry(_) => telemetry = telemetry.saturating_add(1),
-                    v1::Downlink::Reply(_) => replies = replies.saturating_add(1),
-                }
-                let described = describe_v1_downlink(&frame);
-                placed.add(frame.encode().as_slice(), i + 1, described);
+                found(frame, i + 1);
                 next = parser.poll();
             }
         }
@@ -53,7 +58,9 @@ impl Generation for V1 {
         let mut parser = v1::UplinkParser::new();
         for (i, &byte) in capture.bytes.iter().enumerate() {
             if capture.gap_before(i).is_some() {
-                parser.quiet();
+                while let Some(command) = parser.quiet() {
+                    placed.add(&command.encode(), i, describe_v1_uplink(&command));
+                }
             }
             let mut next = parser.push(byte);
             while let Some(command) = next {

@@ -7,7 +7,8 @@
 //! bytes are held it is judged (end `7D`, then the BCC, then whether its content is a frame of
 //! this direction). A frame taken leaves the bytes after it; anything else drops the first byte
 //! held, and the next `7B` among the rest is tried. A byte that cannot start a frame is
-//! discarded at once; the quiet line drops whatever is held.
+//! discarded at once; at a quiet line the start of a frame cut short is dropped a byte at a
+//! time (a frame whole among the bytes held still comes out).
 
 use chassis_protocol::v1::{COMMAND_LEN, Command, Downlink, END, START, Stats, bcc};
 
@@ -110,9 +111,20 @@ impl<D: Direction> Reference<D> {
         }
     }
 
-    /// The line has been quiet: whatever is held is dropped.
-    pub fn quiet(&mut self) {
-        self.drop_front(self.held.len());
+    /// The line has been quiet: nothing that comes next completes what is held. A frame among
+    /// the bytes held comes out (call again until `None`); the start of a frame cut short is
+    /// dropped a byte at a time, so that a frame that began inside it is still found. At `None`
+    /// nothing is held.
+    pub fn quiet(&mut self) -> Option<D::Frame> {
+        loop {
+            if let Some(frame) = self.poll() {
+                return Some(frame);
+            }
+            if self.held.is_empty() {
+                return None;
+            }
+            self.drop_front(1);
+        }
     }
 
     /// What it has seen.

@@ -175,21 +175,25 @@ impl Scorer {
         self.score.errors += rx.errors;
         self.score.expected_undetected += arrived.expected_undetected;
         for (byte, origin) in rx.bytes.iter().zip(&rx.origin) {
-            if self.window.len() == WINDOW {
-                self.window.pop_front();
-            }
             let origin = origin.map(|o| o + base);
-            self.window.push_back((*byte, origin));
             if let Some(o) = origin {
                 if self.quiet
                     && self
                         .last_origin
                         .is_some_and(|p| p < o && self.quiet_between(p, o))
                 {
-                    self.parser.quiet();
+                    // (Before this byte is in the window: a frame the quiet line gives ends
+                    // right before it.)
+                    while let Some(frame) = self.parser.quiet() {
+                        self.judge(frame);
+                    }
                 }
                 self.last_origin = Some(o);
             }
+            if self.window.len() == WINDOW {
+                self.window.pop_front();
+            }
+            self.window.push_back((*byte, origin));
             let mut out = self.parser.push(*byte);
             while let Some(frame) = out {
                 self.judge(frame);

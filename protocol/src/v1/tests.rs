@@ -271,7 +271,7 @@ fn a_frame_never_spans_a_quiet_line() {
     // nothing is made of it, and the bytes are counted.
     let mut told = DownlinkParser::new();
     assert_eq!(told.frames(&joined[..4]).count(), 0);
-    told.quiet();
+    assert_eq!(told.quiet(), None);
     assert_eq!(told.buffered(), 0);
     assert_eq!(told.frames(&joined[4..]).count(), 0);
     assert_eq!(told.stats().frames, 0);
@@ -282,7 +282,7 @@ fn a_frame_never_spans_a_quiet_line() {
         ..Telemetry::default()
     }
     .encode();
-    told.quiet();
+    assert_eq!(told.quiet(), None);
     assert_eq!(told.frames(&whole).count(), 1);
 }
 

@@ -243,11 +243,27 @@ impl<const N: usize> Framer<N> {
         self.decode_held::<D>(need)
     }
 
-    /// The line was quiet: whatever is held is the start of a frame cut short (a frame's bytes
-    /// come back to back), never to be completed by what comes next. Thrown away, counted.
-    pub(super) fn quiet(&mut self) {
-        add(&mut self.stats.discarded, self.len);
-        self.clear();
+    /// The line was quiet: nothing that comes next completes what is held (a frame's bytes
+    /// come back to back). A frame whole among the bytes held comes out (call again until
+    /// `None`); the start of a frame cut short is thrown away a byte at a time, counted, so that
+    /// a frame that began inside it is still found. At `None` nothing is held.
+    pub(super) fn quiet<D: Direction>(&mut self) -> Option<D::Frame> {
+        loop {
+            if let Some(frame) = self.poll::<D>() {
+                return Some(frame);
+            }
+            // Settled: nothing, or the start of a candidate that will never be whole.
+            if self.len == 0 {
+                return None;
+            }
+            // Its 7B goes; a frame may begin after it.
+            add(&mut self.stats.discarded, 1);
+            if let Some(need) = self.settle::<D>(1) {
+                if let Some(frame) = self.decode_held::<D>(need) {
+                    return Some(frame);
+                }
+            }
+        }
     }
 
     /// Takes bytes from the front of `bytes` until a frame comes out (a frame whole in them is

@@ -134,14 +134,17 @@ impl DownlinkParser {
     }
 
     /// The line has been quiet (no byte for longer than any gap inside a frame: 2 ms on a
-    /// UART, 40 ms behind a USB-UART adapter). A frame's bytes come back to back, so the bytes
-    /// held are the start of a frame cut short: they are thrown away (counted as discarded),
-    /// and no frame is ever made of bytes from both sides of a quiet line. Without it, a run of
-    /// exactly one frame's length lost across a frame boundary (a UART overrun) can join the
-    /// start of one frame to the end of the next with a BCC that matches
-    /// (`docs/v1-measurements.md`). Telling it is optional; the driver does.
-    pub fn quiet(&mut self) {
-        self.framer.quiet();
+    /// UART, 40 ms behind a USB-UART adapter). A frame's bytes come back to back, so nothing
+    /// that comes next completes the bytes held: a frame whole among them comes out (call it
+    /// until `None`), the start of a frame cut short is thrown away (counted as discarded; a
+    /// frame that began inside it is still found), and no frame is ever made of bytes from both
+    /// sides of a quiet line. Without it, a run of exactly one frame's length lost across a
+    /// frame boundary (a UART overrun) can join the start of one frame to the end of the next
+    /// with a BCC that matches (`docs/v1-measurements.md`). Telling it is optional; the driver
+    /// does.
+    #[must_use = "a frame found among the bytes held comes out here: call it until None"]
+    pub fn quiet(&mut self) -> Option<Downlink> {
+        self.framer.quiet::<BoardToMaster>()
     }
 }
 
@@ -190,9 +193,10 @@ impl UplinkParser {
         self.framer.stats()
     }
 
-    /// The line has been quiet: as [`DownlinkParser::quiet`].
-    pub fn quiet(&mut self) {
-        self.framer.quiet();
+    /// The line has been quiet: as [`DownlinkParser::quiet`] (call it until `None`).
+    #[must_use = "a command found among the bytes held comes out here: call it until None"]
+    pub fn quiet(&mut self) -> Option<Command> {
+        self.framer.quiet::<MasterToBoard>()
     }
 }
 
@@ -206,13 +210,7 @@ impl Parser for DownlinkParser {
         DownlinkParser::poll(self)
     }
     fn quiet(&mut self, _ms: u32) -> Option<Downlink> {
-        // A frame already whole among the bytes held comes out first; then, a frame's bytes
-        // coming back to back, the start of one cut short by the quiet goes.
-        if let Some(frame) = DownlinkParser::poll(self) {
-            return Some(frame);
-        }
-        DownlinkParser::quiet(self);
-        None
+        DownlinkParser::quiet(self)
     }
     fn buffered(&self) -> usize {
         DownlinkParser::buffered(self)
@@ -236,11 +234,7 @@ impl Parser for UplinkParser {
         UplinkParser::poll(self)
     }
     fn quiet(&mut self, _ms: u32) -> Option<Command> {
-        if let Some(frame) = UplinkParser::poll(self) {
-            return Some(frame);
-        }
-        UplinkParser::quiet(self);
-        None
+        UplinkParser::quiet(self)
     }
     fn buffered(&self) -> usize {
         UplinkParser::buffered(self)
