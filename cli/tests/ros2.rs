@@ -6,7 +6,8 @@
 
 use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Output};
+use std::sync::{Mutex, MutexGuard};
 
 /// A fresh folder holding a copy of `chassis` (so that "beside the program" is this folder).
 fn folder(name: &str) -> PathBuf {
@@ -14,12 +15,50 @@ fn folder(name: &str) -> PathBuf {
         std::env::temp_dir().join(format!("chassis-ros2-front-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
+    let _files = files();
     std::fs::copy(env!("CARGO_BIN_EXE_chassis"), dir.join("chassis")).unwrap();
     dir
 }
 
+/// Held while this test process writes a program (the copy of `chassis`, a script) and while
+/// it starts one. A child forked by another test's thread while a program is open for writing
+/// keeps it open, and running that program then fails with "text file busy"; with the lock no
+/// fork falls while one is.
+static FILES: Mutex<()> = Mutex::new(());
+
+fn files() -> MutexGuard<'static, ()> {
+    FILES
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+trait OutputRetrying {
+    /// `output()`, started under [`FILES`] (and tried again on "text file busy", which a
+    /// process outside the lock can still cause).
+    fn output_retrying(&mut self) -> Output;
+}
+
+impl OutputRetrying for Command {
+    fn output_retrying(&mut self) -> Output {
+        for _ in 0..50 {
+            let output = {
+                let _files = files();
+                self.output()
+            };
+            match output {
+                Err(e) if e.kind() == std::io::ErrorKind::ExecutableFileBusy => {
+                    std::thread::sleep(std::time::Duration::from_millis(20));
+                }
+                other => return other.unwrap(),
+            }
+        }
+        self.output().unwrap()
+    }
+}
+
 /// An executable script at `path`.
 fn script(path: &Path, text: &str) {
+    let _files = files();
     std::fs::write(path, text).unwrap();
     std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o755)).unwrap();
 }
@@ -47,8 +86,7 @@ fn the_node_beside_chassis_gets_every_argument_and_gives_its_status() {
             "--help",
         ])
         .env("PATH", "")
-        .output()
-        .unwrap();
+        .output_retrying();
     assert_eq!(out.status.code(), Some(7), "{out:?}");
     assert_eq!(
         std::fs::read_to_string(&said).unwrap(),
@@ -65,8 +103,7 @@ fn the_node_beside_chassis_gets_every_argument_and_gives_its_status() {
             "--no-tf",
         ])
         .env("PATH", "")
-        .output()
-        .unwrap();
+        .output_retrying();
     assert_eq!(out.status.code(), Some(7), "{out:?}");
     assert_eq!(
         std::fs::read_to_string(&said).unwrap(),
@@ -83,8 +120,7 @@ fn the_node_on_path_is_found_and_none_is_a_clear_error() {
     let out = Command::new(dir.join("chassis"))
         .args(["ros2", "--port", "/dev/null"])
         .env("PATH", &bin)
-        .output()
-        .unwrap();
+        .output_retrying();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(127), "{stderr}");
     assert!(
@@ -96,8 +132,7 @@ fn the_node_on_path_is_found_and_none_is_a_clear_error() {
     let out = Command::new(dir.join("chassis"))
         .args(["ros2"])
         .env("PATH", &bin)
-        .output()
-        .unwrap();
+        .output_retrying();
     assert_eq!(out.status.code(), Some(0), "{out:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -108,8 +143,7 @@ fn record_is_refused_for_the_node() {
     let out = Command::new(dir.join("chassis"))
         .args(["--record", "x.csv", "ros2", "--port", "/dev/null"])
         .env("PATH", "")
-        .output()
-        .unwrap();
+        .output_retrying();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(
