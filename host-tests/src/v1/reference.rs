@@ -115,6 +115,7 @@ impl<D: Direction> Reference<D> {
     /// the bytes held comes out (call again until `None`); the start of a frame cut short is
     /// dropped a byte at a time, so that a frame that began inside it is still found. At `None`
     /// nothing is held.
+    #[must_use = "a frame found among the bytes held comes out here: call it until None"]
     pub fn quiet(&mut self) -> Option<D::Frame> {
         loop {
             if let Some(frame) = self.poll() {
