@@ -46,12 +46,6 @@ impl<const N: usize> Window<N> {
         self.len() >= N
     }
 
-    /// Whether `n` more bytes fit at the end as they are (without the bytes kept moving).
-    #[inline]
-    pub(crate) fn fits(&self, n: usize) -> bool {
-        usize::from(self.end).saturating_add(n) <= N
-    }
-
     /// Appends one byte if there is room at the end; `false` if not (nothing done).
     #[inline]
     pub(crate) fn push(&mut self, byte: u8) -> bool {

@@ -77,7 +77,7 @@ impl DownlinkParser {
     /// [`push`](Self::push) through the general judgement.
     #[inline(never)]
     pub(super) fn push_general(&mut self, byte: u8) -> Option<Downlink> {
-        let ready = if self.drain { self.complete() } else { None };
+        let ready = if self.drain { self.poll() } else { None };
         self.append(&[byte]);
         match ready {
             Some(frame) => {
@@ -85,7 +85,7 @@ impl DownlinkParser {
                 self.missing = 0;
                 Some(frame)
             }
-            None => self.complete(),
+            None => self.poll(),
         }
     }
 

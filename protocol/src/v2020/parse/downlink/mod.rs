@@ -233,7 +233,7 @@ impl DownlinkParser {
     /// only copies a frame's body in one step where no decision can fall in between.
     pub fn push_slice<'a>(&mut self, mut bytes: &'a [u8]) -> (Option<Downlink>, &'a [u8]) {
         if self.drain {
-            if let Some(frame) = self.complete() {
+            if let Some(frame) = self.poll() {
                 return (Some(frame), bytes);
             }
         }
@@ -263,20 +263,7 @@ impl DownlinkParser {
                     Kind::from_header(*a, *b).map_or(1, |kind| kind.len().saturating_sub(1))
                 }
                 // What the last judgement said it needs before anything can be decided.
-                _ => {
-                    let missing = usize::from(self.missing);
-                    if bytes.len() < missing && self.buf.fits(bytes.len()) {
-                        // The slice ends before them: its bytes are only stored, as `push`
-                        // stores them (nothing is judged early: what `expect_reply` or
-                        // `quiet` says next is heard as after bytes pushed one by one).
-                        self.buf.extend(bytes);
-                        self.missing = self
-                            .missing
-                            .saturating_sub(u8::try_from(bytes.len()).unwrap_or(u8::MAX));
-                        return (None, &[]);
-                    }
-                    missing
-                }
+                _ => usize::from(self.missing),
             };
             let step = step.max(1).min(bytes.len());
             let (now, later) = bytes.split_at_checked(step).unwrap_or((bytes, &[]));
@@ -300,12 +287,7 @@ impl DownlinkParser {
     }
 
     /// Emits a frame that is already decided in the window, if any, without a new byte.
-    /// Nothing is judged while bytes the last judgement waits for are still to come (then
-    /// `None`): the same decisions fall at the same bytes whether or not `poll` is called.
     pub fn poll(&mut self) -> Option<Downlink> {
-        if self.missing > 0 {
-            return None;
-        }
         // (After a chain proved a frame, the next is often alone in the window: row 1.)
         self.complete()
     }
