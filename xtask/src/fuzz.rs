@@ -3,6 +3,7 @@
 
 use crate::cmd::{check, host_tests, workspace_root};
 use crate::tools::{install_cargo_tool, install_nightly};
+use std::path::Path;
 use std::process::Command;
 
 /// The fuzz targets, in `host-tests/fuzz`, each with the number of runs `test` gives it (about
@@ -29,6 +30,27 @@ pub(crate) enum FuzzRun {
     Explore(u32),
 }
 
+/// Copies the inputs that once crashed a target (`host-tests/fuzz/regressions/<target>/`, kept
+/// in the repository) into its corpus, so that every run, the repeatable one included, goes
+/// through them first.
+fn add_regressions(regressions: &Path, corpus: &Path) -> Result<(), String> {
+    for (target, _) in FUZZ_TARGETS {
+        let Ok(inputs) = std::fs::read_dir(regressions.join(target)) else {
+            continue;
+        };
+        let into = corpus.join(target);
+        std::fs::create_dir_all(&into)
+            .map_err(|e| format!("cannot create {}: {e}", into.display()))?;
+        for input in inputs {
+            let input = input.map_err(|e| format!("cannot list {}: {e}", regressions.display()))?;
+            let to = into.join(format!("regression-{}", input.file_name().to_string_lossy()));
+            std::fs::copy(input.path(), &to)
+                .map_err(|e| format!("cannot copy {}: {e}", input.path().display()))?;
+        }
+    }
+    Ok(())
+}
+
 /// Runs every fuzz target, from generated seed corpora; fails on any crash.
 pub(crate) fn fuzz(run: FuzzRun) -> Result<(), String> {
     install_nightly()?;
@@ -48,6 +70,7 @@ pub(crate) fn fuzz(run: FuzzRun) -> Result<(), String> {
     };
     let corpus_arg = corpus.to_string_lossy().into_owned();
     host_tests("--bin", "fuzz-seeds", &[&corpus_arg])?;
+    add_regressions(&fuzz_dir.join("regressions"), &corpus)?;
     for (target, runs) in FUZZ_TARGETS {
         let target_corpus = corpus.join(target).to_string_lossy().into_owned();
         let limits = match run {
