@@ -1198,16 +1198,13 @@ fn v2020_one_frame_repeated_is_no_stream() {
 }
 
 #[test]
-fn v2020_extra_polls_change_nothing_without_expect_reply() {
+fn v2020_extra_polls_change_nothing_expect_reply_included() {
     on_a_big_stack(|| {
-        // `poll` after any piece, against polling only after a frame: the same, as long as no
-        // `expect_reply` comes between (see the ignored test on `poll` for what does differ).
+        // `poll` after any piece, against polling only after a frame: the same, `expect_reply`
+        // calls between included (`poll` judges nothing while the bytes the last judgement
+        // waits for are still to come).
         runner(cases(600), 8)
             .run(&(ops_strategy(), plan()), |(ops, plan)| {
-                let ops: Vec<Op> = ops
-                    .into_iter()
-                    .filter(|o| !matches!(o, Op::Expect(_)))
-                    .collect();
                 let want = Run::<DownlinkParser>::script(
                     &ops,
                     &[(1, Way::PushDrain, false)],
@@ -1799,7 +1796,6 @@ fn v2020_a_false_header_right_before_a_frame_costs_that_frame_only() {
 }
 
 #[test]
-#[ignore = "found by the outside attack: push byte by byte vs push_slice/frames/poll give different frames when expect_reply follows"]
 fn v2020_the_same_bytes_then_expect_reply_any_way_fed() {
     // After a quiet line, a reply `23 0C FF FF FF FF` and one byte `01`; then the master says
     // it awaits that register (battery range, reply code 0x0C); then the line goes quiet.
@@ -2360,4 +2356,114 @@ fn v2020_from_a_quiet_line_every_frame_whatever_the_step() {
         got.extend(quiet(&mut p, 5));
         assert_eq!(got, sent, "one shared counter, step {step}");
     }
+}
+// ---------------------------------------------------------------------------------------------
+// The 2020 parser: cases the property tests found at 20 000 cases a test (`ATTACK_CASES`)
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn v2020_bytes_after_a_chains_first_frame_wait_for_the_rest_of_the_chain() {
+    // A chain proves several frames at the count byte of the last; the first comes out of that
+    // `push`, the others of the next calls. The bytes pushed meanwhile are judged after the
+    // rest of the chain, as when the caller polls after every frame: here, judged before it,
+    // a reply `23 01 FF FA 00 00` nobody awaited yet was thrown away before `expect_reply`
+    // came for it.
+    let mut bytes = vec![
+        0xFF, 0xFA, 0xFF, 0xFB, 0xFF, 0xFB, 0xFF, 0xFB, 0xFF, 0xFC, 0xFF, 0xFC, 0xFF, 0xFB, 1,
+    ];
+    bytes.extend([
+        0xFF, 0xFA, 0xFF, 0xFB, 0xFF, 0xFC, 0xFF, 0xFC, 0xFF, 0xFB, 0xFF, 0xFC, 0xFF, 0xFB, 2,
+    ]);
+    bytes.extend([
+        0x23, 0x01, 0xFF, 0xFA, 0x00, 0xFF, 0x23, 0x01, 0xFF, 0xFA, 0x00, 0x00,
+    ]);
+    bytes.extend([
+        0xFF, 0xFA, 0xFF, 0xFB, 0xFF, 0xFC, 0xFF, 0xFB, 0xFF, 0xFC, 0xFF, 0xFC, 0xFF, 0xFB, 3,
+    ]);
+    bytes.extend([
+        0xFF, 0xFA, 0xFF, 0xFB, 0xFF, 0xFB, 0xFF, 0xFC, 0xFF, 0xFC, 0xFF, 0xFB, 0xFF, 0xFB, 4,
+    ]);
+    bytes.extend([
+        0xFF, 0xFB, 0xFF, 0xFB, 0xFF, 0xFB, 0xFF, 0xFB, 0xFF, 0xFB, 41,
+    ]);
+    bytes.extend([0x23, 0x01, 0xFF, 0xFA, 0x00, 0x00]);
+    bytes.extend([0xFF, 0xFC, 0xFF, 0x00, 0x00, 0x00, 0x00, 201]);
+    let ops = [Op::Bytes(bytes), Op::Expect(Some(Register::MaxSpeed))];
+    let plan = [(3, Way::PushOnly, false), (2, Way::PushDrain, false)];
+    same_as_reference::<DownlinkParser>(&ops, &plan, DRAIN).unwrap();
+    let want = reference::<DownlinkParser>(&ops);
+    assert_eq!(
+        want.frames.last(),
+        Some(&Downlink::Reply(Reply {
+            code: 0x01,
+            value: 0xFFFA_0000
+        }))
+    );
+}
+
+#[test]
+fn v2020_expect_reply_between_polls_changes_nothing() {
+    // A reply `23 09 FF 23 06 FF` nobody awaits, then `FA`; the master says it awaits the
+    // system mode, then that it awaits nothing. A `poll` in between judges nothing (the
+    // candidate is judged at the next byte, as without the `poll`): no reply either way.
+    let line = [0x23, 0x09, 0xFF, 0x23, 0x06, 0xFF, 0xFA];
+    for poll in [false, true] {
+        let mut p = DownlinkParser::new();
+        let mut got = quiet(&mut p, 0);
+        for b in line {
+            got.extend(p.push(b));
+        }
+        p.expect_reply(Some(Register::SystemMode));
+        if poll {
+            got.extend(std::iter::from_fn(|| p.poll()));
+        }
+        p.expect_reply(None);
+        got.extend(std::iter::from_fn(|| p.poll()));
+        got.extend(quiet(&mut p, 100));
+        assert!(
+            !got.iter().any(|f| matches!(f, Downlink::Reply(_))),
+            "poll {poll}: {got:?}"
+        );
+    }
+}
+
+#[test]
+fn v2020_expect_reply_before_a_chains_frames_are_out_applies_after_them() {
+    // The master awaits the motor voltage; three IMU frames, its reply, a reply to a read of
+    // max speed and a fourth IMU frame, whose count proves the chain; then, before polling the
+    // chain's frames out, the master says it awaits nothing more. The frames the chain proved
+    // come out as decided: both replies included.
+    let imu = |seq: u8| {
+        let mut f = vec![0xFF, 0xFA];
+        f.extend([0xFF, 0xFB].repeat(6));
+        f.push(seq);
+        f
+    };
+    let mut bytes = Vec::new();
+    for seq in 1..=3 {
+        bytes.extend(imu(seq));
+    }
+    bytes.extend([0x23, 0x0B, 0xFF, 0xFA, 0x00, 0x00]);
+    bytes.extend([0x23, 0x01, 0xFF, 0xFA, 0x00, 0x00]);
+    bytes.extend(imu(4));
+    let ops = [
+        Op::Expect(Some(Register::MotorVoltage)),
+        Op::Bytes(bytes),
+        Op::Expect(None),
+    ];
+    let want = Run::<DownlinkParser>::script(&ops, &[(1, Way::PushDrain, false)], AS_DOCUMENTED);
+    let undrained = Drain {
+        before_quiet: true,
+        before_expect: false,
+        only_pending: true,
+    };
+    let got = Run::<DownlinkParser>::script(&ops, &[(1, Way::PushOnly, false)], undrained);
+    assert!(got.broken.is_none(), "{:?}", got.broken);
+    assert_eq!(got.frames, want.frames);
+    let replies = want
+        .frames
+        .iter()
+        .filter(|f| matches!(f, Downlink::Reply(_)))
+        .count();
+    assert_eq!((want.frames.len(), replies), (6, 2), "{:?}", want.frames);
 }

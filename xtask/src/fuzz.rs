@@ -43,7 +43,10 @@ fn add_regressions(regressions: &Path, corpus: &Path) -> Result<(), String> {
             .map_err(|e| format!("cannot create {}: {e}", into.display()))?;
         for input in inputs {
             let input = input.map_err(|e| format!("cannot list {}: {e}", regressions.display()))?;
-            let to = into.join(format!("regression-{}", input.file_name().to_string_lossy()));
+            let to = into.join(format!(
+                "regression-{}",
+                input.file_name().to_string_lossy()
+            ));
             std::fs::copy(input.path(), &to)
                 .map_err(|e| format!("cannot copy {}: {e}", input.path().display()))?;
         }

@@ -62,8 +62,11 @@ const PROBES: [&str; 8] = [
 pub mod budget {
     /// The whole QEMU bring-up firmware's flash. 32 KiB while it ran the 2020 bring-up alone
     /// (30 872 B); raised to 46 KiB when it learnt to detect the generation and run the v1.0.0
-    /// bring-up too (45 476 B: detection, the v1.0.0 driver and parser, the v1.0.0 checks).
-    pub const FIRMWARE_FLASH: u64 = 46 * 1024;
+    /// bring-up too (45 476 B: detection, the v1.0.0 driver and parser, the v1.0.0 checks);
+    /// raised to 47 KiB (46 128 → 47 080 B) when the 2020 parser learnt to judge at the same
+    /// bytes however they are fed (`push`, `push_slice`, `poll`, `expect_reply`): the bytes
+    /// pushed while a chain's frames are still coming out wait behind them.
+    pub const FIRMWARE_FLASH: u64 = 47 * 1024;
     /// The whole QEMU bring-up firmware's RAM (static here; the stack peak is checked by the
     /// end-to-end test, which reads it from the firmware's log).
     pub const FIRMWARE_RAM: u64 = 8 * 1024;
@@ -84,15 +87,20 @@ pub mod budget {
     /// ways of their own (408 B for 3.2 instructions a byte less on the Cortex-M4). Raised to
     /// 13.5 KiB for what an outside attack found (152 B: `poll` and the slice path judge at
     /// the bytes `push` judges at; an awaited reply that may be a frame's tail is not taken):
-    /// 13 408 B; 13 496 B with the frames-in-step rule across streams on again.
-    pub const PROTOCOL_CEILING: u64 = 13 * 1024 + 512;
+    /// 13 408 B; 13 496 B with the frames-in-step rule across streams on again. Raised to
+    /// 14 KiB when the parser learnt to judge at the same bytes however they are fed and
+    /// polled, `expect_reply` calls between included (528 B: the bytes pushed while a chain's
+    /// frames are still coming out wait behind them, an `expect_reply` made then waits until
+    /// those frames are out, and the slice path stores and judges where `push` does): 14 024 B.
+    pub const PROTOCOL_CEILING: u64 = 14 * 1024;
     /// Hardware boards' budgets, by directory: (flash, static RAM), a little above what each
     /// measured when it was added (a regression guard; the ESP32-C3's RAM counts the 3 KiB of
     /// code esp-hal runs from its SRAM).
     pub const BOARDS: [(&str, u64, u64); 3] = [
         ("esp32c3", 70 * 1024, 5 * 1024),
         ("nrf52840", 48 * 1024, 4 * 1024),
-        ("stm32-dma", 50 * 1024, 4 * 1024),
+        // (Raised from 50 KiB with the parsers' ceiling above: 50 916 → 51 544 B.)
+        ("stm32-dma", 51 * 1024, 4 * 1024),
     ];
     /// What the v1.0.0 board → master parser may not grow past (`size_v1_downlink` − board): a
     /// regression guard a little above what it measured when it was set (2 424 B).

@@ -91,6 +91,29 @@ impl<const N: usize> Window<N> {
         self.start = 0;
     }
 
+    /// Hides the last `n` bytes (all of them if there are fewer) from everything but
+    /// [`unhide`](Self::unhide); returns where they are. Until then nothing may be added.
+    pub(crate) fn hide(&mut self, n: u8) -> u8 {
+        let n = n.min(self.end.saturating_sub(self.start));
+        self.end = self.end.saturating_sub(n);
+        self.end
+    }
+
+    /// Puts `n` bytes hidden at `at` back after the bytes kept (moved there if the front was
+    /// dropped to the start meanwhile).
+    pub(crate) fn unhide(&mut self, at: u8, n: u8) {
+        let (at, end) = (usize::from(at), usize::from(self.end));
+        if at != end {
+            for i in 0..usize::from(n) {
+                let byte = self.bytes.get(at.saturating_add(i)).copied().unwrap_or(0);
+                if let Some(to) = self.bytes.get_mut(end.saturating_add(i)) {
+                    *to = byte;
+                }
+            }
+        }
+        self.end = u8::try_from(end.saturating_add(usize::from(n)).min(N)).unwrap_or(self.end);
+    }
+
     /// Forgets every byte kept.
     #[inline]
     pub(crate) fn clear(&mut self) {

@@ -74,19 +74,98 @@ impl DownlinkParser {
         self.push_general(byte)
     }
 
-    /// [`push`](Self::push) through the general judgement.
+    /// [`push`](Self::push) through the general judgement. A frame already decided comes out
+    /// first (the byte is stored behind it, judged at the next call); else the byte is stored,
+    /// and the window judged only if the last judgement waits for no more than this byte (or
+    /// the window was full and its first byte went): judgements fall at the same bytes however
+    /// the bytes are fed and polled.
     #[inline(never)]
     pub(super) fn push_general(&mut self, byte: u8) -> Option<Downlink> {
-        let ready = if self.drain { self.poll() } else { None };
-        self.append(&[byte]);
-        match ready {
-            Some(frame) => {
-                // (The window is not empty now: `missing` of 2 is for an empty one.)
-                self.missing = 0;
-                Some(frame)
-            }
-            None => self.poll(),
+        let ready = if self.drain {
+            self.complete_behind()
+        } else {
+            None
+        };
+        let full = self.buf.is_full();
+        if full || !self.buf.push(byte) {
+            self.append(&[byte]);
         }
+        if ready.is_some() {
+            // The byte waits behind what is left of the window (if anything): judged after
+            // it, at the next call, as if the frame had been polled out before the byte came.
+            self.missing = 0;
+            self.behind = self.behind.saturating_add(1);
+            self.drain = true;
+        } else if self.missing > 1 && !full {
+            self.missing = self.missing.wrapping_sub(1);
+        } else {
+            return self.complete();
+        }
+        ready
+    }
+
+    /// [`complete`](Self::complete) while bytes wait [`behind`](Self::behind): the window is
+    /// judged without them first, then they are taken one at a time, each as
+    /// [`push_general`](Self::push_general) takes a byte, until a frame comes out. Whichever
+    /// way the bytes were fed, each judgement sees the bytes it sees when every byte is pushed
+    /// alone and polled after.
+    #[inline(never)]
+    pub(super) fn complete_behind(&mut self) -> Option<Downlink> {
+        let behind = self.behind;
+        let mut left = behind;
+        let mut at = self.buf.hide(left);
+        // The window without them first (as a `poll` would judge it), then at each byte behind
+        // that ends a wait.
+        let mut judge = self.drain || self.missing == 0;
+        let frame = loop {
+            if judge {
+                if let Some(frame) = self.complete() {
+                    break Some(frame);
+                }
+            }
+            if left == 0 {
+                break None;
+            }
+            let taken = behind.wrapping_sub(left);
+            if self.expect_next.is_some_and(|(_, at)| at == taken) {
+                self.expect_pending();
+            }
+            self.buf.unhide(at, 1);
+            at = at.wrapping_add(1);
+            left = left.wrapping_sub(1);
+            judge = self.missing <= 1;
+            if !judge {
+                self.missing = self.missing.wrapping_sub(1);
+            }
+        };
+        self.buf.unhide(at, left);
+        if let Some((_, at)) = &mut self.expect_next {
+            *at = at.saturating_sub(behind.wrapping_sub(left));
+        }
+        self.behind = left;
+        if left > 0 {
+            self.drain = true;
+        } else if !self.drain {
+            self.expect_pending();
+        }
+        frame
+    }
+
+    /// What [`expect_reply`](Self::expect_reply) said while frames were still to come out, now
+    /// that they are out.
+    fn expect_pending(&mut self) {
+        if let Some((code, _)) = self.expect_next.take() {
+            self.expect_now(code);
+        }
+    }
+
+    /// [`expect_reply`](Self::expect_reply) from now on. A candidate waiting in the window may
+    /// be judged differently now: it is judged at the next byte, not only once the bytes it
+    /// was waiting for are in (and not at a `poll` before it: whether the caller polls in
+    /// between changes nothing).
+    pub(super) fn expect_now(&mut self, code: Option<u8>) {
+        self.expect = code;
+        self.missing = self.missing.min(self.front_missing()).max(1);
     }
 
     pub(super) fn run(&mut self, quiet: bool) -> Option<Downlink> {

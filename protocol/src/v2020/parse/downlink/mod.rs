@@ -132,8 +132,16 @@ pub struct DownlinkParser {
     lock: Lock,
     /// The reply code awaited, if any.
     expect: Option<u8>,
+    /// What [`expect_reply`](DownlinkParser::expect_reply) said while frames were still to
+    /// come out, and how many bytes were [`behind`](DownlinkParser::behind) then: it applies
+    /// once those frames and bytes are judged, as if they had all come out before the call.
+    expect_next: Option<(Option<u8>, u8)>,
     /// The last call emitted a frame: another may be ready without a new byte.
     drain: bool,
+    /// Bytes stored at the window's end while `drain` (after a frame came out, before the next
+    /// call): the judgement does not see them until what was before them is judged, then
+    /// takes them one at a time, as if each had come after a `poll`.
+    behind: u8,
     /// Bytes consumed since the last frame taken (saturating).
     since_frame: u16,
     /// Bytes to store before anything can be decided (0 or 1: none; always 0 while `drain`):
@@ -150,7 +158,7 @@ pub struct DownlinkParser {
 }
 
 const _: () = assert!(
-    core::mem::size_of::<DownlinkParser>() <= 220,
+    core::mem::size_of::<DownlinkParser>() <= 224,
     "DownlinkParser over its RAM budget"
 );
 
@@ -199,7 +207,9 @@ impl DownlinkParser {
             counts: Counts::new(),
             lock: Lock::Hunting,
             expect: None,
+            expect_next: None,
             drain: false,
+            behind: 0,
             since_frame: 0,
             missing: 0,
             resynced: false,
@@ -231,51 +241,66 @@ impl DownlinkParser {
     /// again with the rest until it returns `(None, [])`. It goes through the same decisions as
     /// feeding the same bytes one at a time, so it emits the same frames in the same order; it
     /// only copies a frame's body in one step where no decision can fall in between.
+    #[inline(never)]
     pub fn push_slice<'a>(&mut self, mut bytes: &'a [u8]) -> (Option<Downlink>, &'a [u8]) {
-        if self.drain {
-            if let Some(frame) = self.poll() {
-                return (Some(frame), bytes);
-            }
-        }
-        while !bytes.is_empty() {
-            // With nothing kept, bytes that start no frame are thrown away at once.
-            if self.buf.is_empty() {
-                let junk = bytes.iter().take_while(|b| !Kind::may_start(**b)).count();
-                if junk > 0 {
-                    self.discard_run(bytes.get(..junk).unwrap_or(&[]));
-                    bytes = bytes.get(junk..).unwrap_or(&[]);
+        while let Some((&byte, rest)) = bytes.split_first() {
+            if !self.drain {
+                // With nothing kept, bytes that start no frame are thrown away at once.
+                if self.buf.is_empty() && self.missing == 0 {
+                    let junk = bytes.iter().take_while(|b| !Kind::may_start(**b)).count();
+                    if junk > 0 {
+                        self.discard_run(bytes.get(..junk).unwrap_or(&[]));
+                        bytes = bytes.get(junk..).unwrap_or(&[]);
+                        continue;
+                    }
+                }
+                // On a boundary, a frame that row 1 takes at the front of the window and
+                // `bytes`: taken without the window.
+                if let Some((frame, used)) = self.take_straight(bytes) {
+                    return (Some(frame), bytes.get(used..).unwrap_or(&[]));
+                }
+                if self.store_cut(bytes) {
+                    return (None, &[]);
+                }
+                // A frame whose header is (or starts) at the front, whole in `bytes`, or the
+                // bytes the last judgement waits for, all in `bytes`: stored in one copy, and
+                // judged at the last, as `push` judges them. (A byte at most is kept before a
+                // header: the frame fits.)
+                let whole = match (self.buf.as_slice(), bytes) {
+                    ([], [a, b, ..]) => Kind::from_header(*a, *b).map(Kind::len),
+                    ([a], [b, ..]) => {
+                        Kind::from_header(*a, *b).map(|kind| kind.len().saturating_sub(1))
+                    }
+                    _ => None,
+                };
+                let awaited = usize::from(self.missing);
+                let awaited = (awaited > 1 && awaited <= WINDOW.saturating_sub(self.buf.len()))
+                    .then_some(awaited);
+                if let Some((now, later)) =
+                    whole.or(awaited).and_then(|n| bytes.split_at_checked(n))
+                {
+                    self.buf.extend(now);
+                    bytes = later;
+                    self.missing = 1;
+                    if let Some(frame) = self.complete() {
+                        return (Some(frame), bytes);
+                    }
                     continue;
                 }
             }
-            // On a boundary, a frame that row 1 takes at the front of the window and `bytes`:
-            // taken without the window.
-            if let Some((frame, used)) = self.take_straight(bytes) {
-                return (Some(frame), bytes.get(used..).unwrap_or(&[]));
-            }
-            if self.store_cut(bytes) {
-                return (None, &[]);
-            }
-            // A frame whose header is (or starts) at the front is taken whole: nothing can be
-            // decided before its last byte.
-            let step = match (self.buf.as_slice(), bytes) {
-                ([], [a, b, ..]) => Kind::from_header(*a, *b).map_or(1, Kind::len),
-                ([a], [b, ..]) => {
-                    Kind::from_header(*a, *b).map_or(1, |kind| kind.len().saturating_sub(1))
-                }
-                // What the last judgement said it needs before anything can be decided.
-                _ => usize::from(self.missing),
-            };
-            let step = step.max(1).min(bytes.len());
-            let (now, later) = bytes.split_at_checked(step).unwrap_or((bytes, &[]));
-            self.append(now);
-            bytes = later;
-            // `complete` takes a frame alone in the window on its own when it can, else it
-            // judges as `poll` does.
-            if let Some(frame) = self.complete() {
+            // Any other byte: as `push` takes it past its short ways.
+            bytes = rest;
+            if let Some(frame) = self.push_general(byte) {
                 return (Some(frame), bytes);
             }
         }
-        (None, bytes)
+        // A frame already decided, with no byte left to store behind it.
+        let ready = if self.drain {
+            self.complete_behind()
+        } else {
+            None
+        };
+        (ready, bytes)
     }
 
     /// An iterator over the frames in `bytes`; every byte is consumed by the time it ends.
@@ -287,9 +312,16 @@ impl DownlinkParser {
     }
 
     /// Emits a frame that is already decided in the window, if any, without a new byte.
+    /// Nothing is judged while bytes the last judgement waits for are still to come (then
+    /// `None`): the same decisions fall at the same bytes whether or not `poll` is called.
+    /// Nothing is judged while bytes the last judgement waits for are still to come (then
+    /// `None`): the same decisions fall at the same bytes whether or not `poll` is called.
     pub fn poll(&mut self) -> Option<Downlink> {
+        if self.missing > 0 {
+            return None;
+        }
         // (After a chain proved a frame, the next is often alone in the window: row 1.)
-        self.complete()
+        self.complete_behind()
     }
 
     /// Tells the parser the line has been quiet for `ms` more milliseconds (any gap of two or
@@ -307,6 +339,12 @@ impl DownlinkParser {
     /// lasts), so the next burst may start in the middle of a frame. The parser then goes on
     /// hunting. (A byte or two missing is noise inside the frame: the next burst is aligned.)
     pub fn quiet(&mut self, ms: u32) -> Option<Downlink> {
+        if self.drain {
+            // Frames not yet out and the bytes stored behind them: taken first, as by `poll`.
+            if let Some(frame) = self.complete_behind() {
+                return Some(frame);
+            }
+        }
         let cut = self.lock != Lock::Hunting && usize::from(self.front_missing()) > MAX_DROPPED;
         let frame = self.run(true);
         if frame.is_none() {
@@ -329,12 +367,18 @@ impl DownlinkParser {
     /// Tells the parser a reply to a read of `register` is awaited (`None`: none is). The
     /// master knows when it asked: an awaited reply is taken on less evidence, and a reply
     /// nobody awaits needs the next frame's count to vouch for it. The awaited code is
-    /// forgotten once its reply comes.
+    /// forgotten once its reply comes. A candidate waiting in the window is judged again at
+    /// the next byte. Called while frames a chain proved are still to come out (before the
+    /// caller has polled them), it applies once they are out, as if they had been polled first.
     pub fn expect_reply(&mut self, register: Option<Register>) {
-        self.expect = register.map(Register::reply_code);
-        // A candidate waiting in the window may be judged differently now: judge it at the
-        // next byte, not only once the bytes it was waiting for are in.
-        self.missing = self.missing.min(self.front_missing());
+        let code = register.map(Register::reply_code);
+        if self.drain {
+            // Frames still to come out were decided without it.
+            self.expect_next = Some((code, self.behind));
+        } else {
+            self.expect_next = None;
+            self.expect_now(code);
+        }
     }
 
     /// How sure the parser is of where frames start.
