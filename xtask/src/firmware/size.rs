@@ -91,8 +91,10 @@ pub mod budget {
     /// 14 KiB when the parser learnt to judge at the same bytes however they are fed and
     /// polled, `expect_reply` calls between included (528 B: the bytes pushed while a chain's
     /// frames are still coming out wait behind them, an `expect_reply` made then waits until
-    /// those frames are out, and the slice path stores and judges where `push` does): 14 024 B.
-    pub const PROTOCOL_CEILING: u64 = 14 * 1024;
+    /// those frames are out, and the slice path stores and judges where `push` does): 14 024 B;
+    /// raised to 14.5 KiB when the bytes behind a chain's frames learnt to keep the state the
+    /// frame before them left (the fuzz target found them left unjudged): 14 360 B.
+    pub const PROTOCOL_CEILING: u64 = 14 * 1024 + 512;
     /// Hardware boards' budgets, by directory: (flash, static RAM), a little above what each
     /// measured when it was added (a regression guard; the ESP32-C3's RAM counts the 3 KiB of
     /// code esp-hal runs from its SRAM).

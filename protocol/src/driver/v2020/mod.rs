@@ -206,7 +206,7 @@ struct Latest {
     streams: [StreamInfo; 3],
 }
 
-// RAM budget of the core (the pump 480: the parser 224 bytes with its 96-byte window, the
+// RAM budget of the core (the pump 480: the parser 228 bytes with its 96-byte window, the
 // receive buffer 48, the frame being sent and the failsafe's timers; the request in progress
 // 112, the unanswered reads 72, latest frames and stream figures 184): 896 bytes on 64-bit
 // hosts.

@@ -2,7 +2,7 @@
 //!
 //! | parser | direction | emits | state |
 //! |---|---|---|---|
-//! | [`DownlinkParser`] | board → master | [`Downlink`](crate::Downlink) | 224 bytes (a 96-byte window, learnt counts, counters) |
+//! | [`DownlinkParser`] | board → master | [`Downlink`](crate::Downlink) | 228 bytes (a 96-byte window, learnt counts, counters) |
 //! | [`UplinkParser`] | master → board | [`Command`](crate::Command) | 28 bytes |
 //!
 //! Both are `const fn new()`, take bytes one at a time ([`push`](DownlinkParser::push)) or a

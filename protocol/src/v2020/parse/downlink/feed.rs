@@ -2,8 +2,8 @@
 //! completes what was missing), and the loop that judges the candidate at the front of the
 //! window until it needs more bytes.
 
-use super::DownlinkParser;
 use super::judge::Verdict;
+use super::{DownlinkParser, RESUME_DRAIN};
 use crate::telemetry::{Downlink, Kind};
 
 impl DownlinkParser {
@@ -93,9 +93,10 @@ impl DownlinkParser {
         if ready.is_some() {
             // The byte waits behind what is left of the window (if anything): judged after
             // it, at the next call, as if the frame had been polled out before the byte came.
-            self.missing = 0;
-            self.behind = self.behind.saturating_add(1);
-            self.drain = true;
+            if self.behind.len == 0 {
+                self.hold_behind();
+            }
+            self.behind.len = self.behind.len.saturating_add(1);
         } else if self.missing > 1 && !full {
             self.missing = self.missing.wrapping_sub(1);
         } else {
@@ -111,9 +112,14 @@ impl DownlinkParser {
     /// alone and polled after.
     #[inline(never)]
     pub(super) fn complete_behind(&mut self) -> Option<Downlink> {
-        let behind = self.behind;
+        let behind = self.behind.len;
         let mut left = behind;
         let mut at = self.buf.hide(left);
+        if behind > 0 && self.behind.resume != RESUME_DRAIN {
+            // The frame before them left nothing ready: the state it left, back.
+            self.drain = false;
+            self.missing = self.behind.resume;
+        }
         // The window without them first (as a `poll` would judge it), then at each byte behind
         // that ends a wait.
         let mut judge = self.drain || self.missing == 0;
@@ -142,13 +148,26 @@ impl DownlinkParser {
         if let Some((_, at)) = &mut self.expect_next {
             *at = at.saturating_sub(behind.wrapping_sub(left));
         }
-        self.behind = left;
+        self.behind.len = left;
         if left > 0 {
-            self.drain = true;
+            self.hold_behind();
         } else if !self.drain {
             self.expect_pending();
         }
         frame
+    }
+
+    /// Bytes wait [`behind`](Self::behind) a frame that just came out: the state that frame
+    /// left is kept for [`complete_behind`](Self::complete_behind), and every call goes there
+    /// first (`drain`, with `missing` 0 as `drain` wants it).
+    fn hold_behind(&mut self) {
+        self.behind.resume = if self.drain {
+            RESUME_DRAIN
+        } else {
+            self.missing
+        };
+        self.drain = true;
+        self.missing = 0;
     }
 
     /// What [`expect_reply`](Self::expect_reply) said while frames were still to come out, now

@@ -138,10 +138,8 @@ pub struct DownlinkParser {
     expect_next: Option<(Option<u8>, u8)>,
     /// The last call emitted a frame: another may be ready without a new byte.
     drain: bool,
-    /// Bytes stored at the window's end while `drain` (after a frame came out, before the next
-    /// call): the judgement does not see them until what was before them is judged, then
-    /// takes them one at a time, as if each had come after a `poll`.
-    behind: u8,
+    /// Bytes stored behind frames not yet out.
+    behind: Behind,
     /// Bytes consumed since the last frame taken (saturating).
     since_frame: u16,
     /// Bytes to store before anything can be decided (0 or 1: none; always 0 while `drain`):
@@ -157,8 +155,25 @@ pub struct DownlinkParser {
     stats: DownlinkStats,
 }
 
+/// Bytes stored at the window's end while `drain` (after a frame came out, before the next
+/// call): the judgement does not see them until what was before them is judged, then takes
+/// them one at a time, as if each had come after a `poll`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Behind {
+    /// How many.
+    len: u8,
+    /// The `missing` the frame before them left, or [`RESUME_DRAIN`] if it left another frame
+    /// ready.
+    resume: u8,
+}
+
+/// [`Behind::resume`] when the frame before the bytes behind left another ready (a `missing`
+/// is never this large).
+const RESUME_DRAIN: u8 = u8::MAX;
+
 const _: () = assert!(
-    core::mem::size_of::<DownlinkParser>() <= 224,
+    core::mem::size_of::<DownlinkParser>() <= 228,
     "DownlinkParser over its RAM budget"
 );
 
@@ -209,7 +224,7 @@ impl DownlinkParser {
             expect: None,
             expect_next: None,
             drain: false,
-            behind: 0,
+            behind: Behind { len: 0, resume: 0 },
             since_frame: 0,
             missing: 0,
             resynced: false,
@@ -374,7 +389,7 @@ impl DownlinkParser {
         let code = register.map(Register::reply_code);
         if self.drain {
             // Frames still to come out were decided without it.
-            self.expect_next = Some((code, self.behind));
+            self.expect_next = Some((code, self.behind.len));
         } else {
             self.expect_next = None;
             self.expect_now(code);
