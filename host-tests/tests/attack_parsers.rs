@@ -628,16 +628,19 @@ const AS_DOCUMENTED: Drain = Drain {
     only_pending: true,
 };
 
+/// The documented way to feed, but `expect_reply` called before the frames a chain proved are
+/// polled out.
+const UNDRAINED_BEFORE_EXPECT: Drain = Drain {
+    before_quiet: true,
+    before_expect: false,
+    only_pending: true,
+};
+
 #[test]
 fn v2020_expect_reply_before_frames_held_back_are_out() {
     on_a_big_stack(|| {
         // `expect_reply` called while frames proved by a chain still wait to come out (the caller
         // has not polled yet): they are decided, and come out the same.
-        let undrained = Drain {
-            before_quiet: true,
-            before_expect: false,
-            only_pending: true,
-        };
         runner(cases(600), 6)
             .run(&ops_strategy(), |ops| {
                 let want = Run::<DownlinkParser>::script(
@@ -645,8 +648,11 @@ fn v2020_expect_reply_before_frames_held_back_are_out() {
                     &[(1, Way::PushDrain, false)],
                     AS_DOCUMENTED,
                 );
-                let got =
-                    Run::<DownlinkParser>::script(&ops, &[(1, Way::PushOnly, false)], undrained);
+                let got = Run::<DownlinkParser>::script(
+                    &ops,
+                    &[(1, Way::PushOnly, false)],
+                    UNDRAINED_BEFORE_EXPECT,
+                );
                 prop_assert!(got.broken.is_none(), "{:?}", got.broken);
                 prop_assert_eq!(&got.frames, &want.frames);
                 prop_assert_eq!(got.parser.observe(), want.parser.observe());
@@ -2452,12 +2458,8 @@ fn v2020_expect_reply_before_a_chains_frames_are_out_applies_after_them() {
         Op::Expect(None),
     ];
     let want = Run::<DownlinkParser>::script(&ops, &[(1, Way::PushDrain, false)], AS_DOCUMENTED);
-    let undrained = Drain {
-        before_quiet: true,
-        before_expect: false,
-        only_pending: true,
-    };
-    let got = Run::<DownlinkParser>::script(&ops, &[(1, Way::PushOnly, false)], undrained);
+    let got =
+        Run::<DownlinkParser>::script(&ops, &[(1, Way::PushOnly, false)], UNDRAINED_BEFORE_EXPECT);
     assert!(got.broken.is_none(), "{:?}", got.broken);
     assert_eq!(got.frames, want.frames);
     let replies = want
