@@ -39,8 +39,8 @@ struct Walk<'a> {
     /// Where the next frame should start, and how many junk bytes may come first.
     pos: usize,
     gap: usize,
-    /// (Own, Restart with no step learnt) the step between the own stream's frames seen, and
-    /// how many times.
+    /// (Own, Restart with no step learnt; Rebase) the step between the own stream's frames seen,
+    /// and how many times.
     own_step: Option<(u8, u8)>,
     /// (Own, Restart) The counts of the chain's telemetry frames, whatever their streams, from
     /// the candidate's on: the last one, the step between each two, and how many times it
@@ -221,7 +221,7 @@ impl<'a> Walk<'a> {
             self.shared = None;
             return Continue(());
         }
-        if self.shared_in_step(stream, seq) {
+        if self.shared_in_step(stream, seq) || self.rebase_in_step(stream, seq) {
             return Break(Ok(true));
         }
         let vouches = self.may_vouch(stream, seq)?;
@@ -238,6 +238,27 @@ impl<'a> Walk<'a> {
             }
             Rel::Far => Break(Ok(false)),
         }
+    }
+
+    /// (Rebase, the candidate's stream with no step learnt) Whether the link, of the
+    /// candidate's own stream, is the [`IN_STEP`]th in a row the same step on, from the
+    /// candidate's count, that step wider than [`FIRST_STEP_MAX`]: a board stepping its count by
+    /// 5 or more, whose counts no chain reads as continuing before a step is learnt, is vouched
+    /// for as hunting vouches for it (row 9).
+    fn rebase_in_step(&mut self, stream: Stream, seq: u8) -> bool {
+        if self.chain != Chain::Rebase || self.own != Some(stream) || self.counts.has_steps(stream)
+        {
+            return false;
+        }
+        let delta = seq.wrapping_sub(self.counts.last(stream));
+        let seen = match self.own_step {
+            None => 1,
+            Some((step, seen)) if step == delta && seen > 0 => seen.saturating_add(1),
+            // Out of step: no longer in step from the candidate's count.
+            Some(_) => 0,
+        };
+        self.own_step = Some((delta, seen));
+        seen >= IN_STEP && wide(delta)
     }
 
     /// Whether the chain asks for frames in step to vouch for a candidate of `stream`: an Own
