@@ -3,7 +3,7 @@
 //! window until it needs more bytes.
 
 use super::judge::Verdict;
-use super::{DownlinkParser, RESUME_DRAIN};
+use super::{DownlinkParser, RESUME_DRAIN, short_ways};
 use crate::telemetry::{Downlink, Kind};
 
 impl DownlinkParser {
@@ -13,6 +13,9 @@ impl DownlinkParser {
     /// [`push_general`](Self::push_general).
     #[inline(never)]
     pub(super) fn push_slow(&mut self, byte: u8) -> Option<Downlink> {
+        if !short_ways() {
+            return self.push_general(byte);
+        }
         if !self.drain {
             if self.missing == 1 {
                 // This byte completes what was missing: a frame's header right after a frame

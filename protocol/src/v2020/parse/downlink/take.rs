@@ -5,7 +5,7 @@
 use super::class::telemetry_header;
 use super::counts::Rel;
 use super::rules::{self, Chain, Facts, Need, Seen, Start, Walk};
-use super::{DownlinkParser, FORGET_AFTER, Lock, MAX_DROPPED};
+use super::{DownlinkParser, FORGET_AFTER, Lock, MAX_DROPPED, short_ways};
 use crate::telemetry::{self, Downlink, Kind, Stream};
 
 // What row 11 needs, whatever kind of boundary: what its shortcut assumes.
@@ -68,6 +68,9 @@ impl DownlinkParser {
     pub(super) fn complete(&mut self) -> Option<Downlink> {
         // Row 1, the common case, without the general bookkeeping (kept apart from the rest:
         // a small function is cheap to enter).
+        if !short_ways() {
+            return self.run(false);
+        }
         let bytes = self.buf.as_slice();
         if let (&[first, second, ..], Some(&seq)) = (bytes, bytes.last()) {
             if let Some(stream) = telemetry_header(&[first, second]) {

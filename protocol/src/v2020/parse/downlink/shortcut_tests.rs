@@ -1,0 +1,233 @@
+//! The short ways against the general judgement alone: on noisy streams of every count model,
+//! with quiet lines, replies and `expect_reply` between, the parser with its short ways (fed by
+//! `push`, by `push_slice` in random slices, and by `frames()`) emits the same frames, leaves the
+//! same statistics and the same lock as the parser that judges every decision with
+//! [`rules::decide`](super::rules::decide) (fed one byte at a time, polled after each).
+//!
+//! `SHORTCUT_CASES` sets the number of streams (default 2 000, what CI runs).
+
+use super::*;
+use crate::{Battery, Encoders, Imu, Reply};
+use std::cell::Cell;
+use std::vec::Vec;
+
+std::thread_local! {
+    /// Set: every decision goes through the general judgement (see [`short_ways`]).
+    pub(super) static GENERAL_ONLY: Cell<bool> = const { Cell::new(false) };
+}
+
+/// A small deterministic generator (xorshift64*), so that a failing stream is a seed.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+    fn below(&mut self, n: u64) -> u64 {
+        self.next() % n.max(1)
+    }
+    fn chance(&mut self, p: f64) -> bool {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64 <= p
+    }
+    /// A sensor value near rest: small (often -6..-4, a header's second byte), sometimes any.
+    fn value(&mut self, rest: i16) -> i16 {
+        if self.chance(0.1) {
+            self.next() as i16
+        } else {
+            rest.wrapping_add(self.below(17) as i16 - 8)
+        }
+    }
+}
+
+/// What the caller does between bytes.
+#[derive(Clone, Debug)]
+enum Op {
+    Bytes(Vec<u8>),
+    Quiet(u32),
+    Expect(Option<Register>),
+}
+
+/// One board stream: telemetry at the board's rates with replies, under one of the count
+/// models A10 allows, through a channel that substitutes, drops and inserts bytes at `rate`,
+/// quiet lines between bursts (and, rarely, inside a frame), and `expect_reply` calls.
+fn stream(seed: u64) -> Vec<Op> {
+    let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+    let model = rng.below(5);
+    let step = [1, 1, 3, 7, 1][model as usize] as u8;
+    let rate = [0.0, 1e-3, 1e-2, 3e-2][rng.below(4) as usize];
+    let mut counts = [rng.next() as u8; 3];
+    let mut shared = counts[0];
+    let mut ops = Vec::new();
+    let mut burst = Vec::new();
+    let start = rng.below(40) as usize;
+    for tick in 0..(60 + rng.below(140)) {
+        let mut frames: Vec<Downlink> = Vec::new();
+        let mut count = |stream: usize, rng: &mut Rng| -> u8 {
+            match model {
+                // One counter shared by all streams, stepping by 1.
+                4 => {
+                    shared = shared.wrapping_add(1);
+                    shared
+                }
+                // A 10 ms tick.
+                0 if rng.chance(0.5) => {
+                    counts[stream].wrapping_add(if stream == 1 { 4 } else { 1 })
+                }
+                _ => {
+                    counts[stream] = counts[stream].wrapping_add(step);
+                    counts[stream]
+                }
+            }
+        };
+        let seq = count(0, &mut rng);
+        frames.push(Downlink::Imu(Imu {
+            accel: [rng.value(0), rng.value(0), rng.value(16_384)],
+            gyro: [rng.value(-5), rng.value(-5), rng.value(0)],
+            seq,
+        }));
+        if tick % 4 == 0 {
+            let seq = count(1, &mut rng);
+            frames.push(Downlink::Encoders(Encoders {
+                ticks: [rng.value(-5), rng.value(0), rng.value(-4), rng.value(0)],
+                seq,
+            }));
+        }
+        if tick % 50 == 7 {
+            let seq = count(2, &mut rng);
+            frames.push(Downlink::Battery(Battery {
+                centivolts: 1_100 + rng.below(100) as u16,
+                percent: rng.below(101) as u16,
+                seq,
+            }));
+        }
+        if rng.chance(0.08) {
+            let register = Register::ALL[rng.below(Register::ALL.len() as u64) as usize];
+            if rng.chance(0.6) {
+                ops.push(Op::Bytes(core::mem::take(&mut burst)));
+                ops.push(Op::Expect(Some(register)));
+            }
+            frames.push(Downlink::Reply(Reply {
+                code: register.reply_code(),
+                value: rng.value(-5) as u16 as u32,
+            }));
+        }
+        for frame in frames {
+            for byte in frame.encode().as_ref() {
+                if rng.chance(rate) {
+                    match rng.below(3) {
+                        0 => burst.push(rng.next() as u8),
+                        1 => {}
+                        _ => burst.extend([*byte, rng.next() as u8]),
+                    }
+                } else {
+                    burst.push(*byte);
+                }
+                if rng.chance(0.002) {
+                    ops.push(Op::Bytes(core::mem::take(&mut burst)));
+                    ops.push(Op::Quiet(1 + rng.below(30) as u32));
+                }
+            }
+        }
+        if rng.chance(0.3) {
+            ops.push(Op::Bytes(core::mem::take(&mut burst)));
+            ops.push(Op::Quiet(1 + rng.below(12) as u32));
+        }
+        if rng.chance(0.05) {
+            ops.push(Op::Bytes(core::mem::take(&mut burst)));
+            ops.push(Op::Expect(None));
+        }
+    }
+    ops.push(Op::Bytes(burst));
+    ops.push(Op::Quiet(5));
+    // A capture that starts anywhere: the first bytes cut off.
+    if let Some(Op::Bytes(first)) = ops
+        .iter_mut()
+        .find(|op| matches!(op, Op::Bytes(b) if !b.is_empty()))
+    {
+        first.drain(..start.min(first.len()));
+    }
+    ops
+}
+
+/// How the bytes are fed.
+#[derive(Clone, Copy, Debug)]
+enum Way {
+    /// The general judgement alone, one byte at a time, polled after each.
+    General,
+    /// `push`, never polled but by `quiet`.
+    Push,
+    /// `push_slice` in slices of 1 to 40 bytes, its frames polled out before the next slice.
+    Slices,
+    /// `frames()` over each run of bytes whole.
+    Frames,
+}
+
+fn run(ops: &[Op], way: Way, seed: u64) -> (Vec<Downlink>, DownlinkStats, Lock) {
+    GENERAL_ONLY.with(|g| g.set(matches!(way, Way::General)));
+    let mut rng = Rng(seed | 1);
+    let mut p = DownlinkParser::new();
+    let mut out = Vec::new();
+    for op in ops {
+        match op {
+            Op::Bytes(bytes) => match way {
+                Way::General => {
+                    for b in bytes {
+                        out.extend(p.push(*b));
+                        out.extend(core::iter::from_fn(|| p.poll()));
+                    }
+                }
+                Way::Push => out.extend(bytes.iter().filter_map(|b| p.push(*b))),
+                Way::Slices => {
+                    let mut rest = bytes.as_slice();
+                    while !rest.is_empty() {
+                        let n = (1 + rng.below(40) as usize).min(rest.len());
+                        let (mut slice, after) = rest.split_at(n);
+                        while !slice.is_empty() {
+                            let (frame, left) = p.push_slice(slice);
+                            out.extend(frame);
+                            slice = left;
+                        }
+                        out.extend(core::iter::from_fn(|| p.poll()));
+                        rest = after;
+                    }
+                }
+                Way::Frames => out.extend(p.frames(bytes)),
+            },
+            Op::Quiet(ms) => out.extend(core::iter::from_fn(|| p.quiet(*ms))),
+            Op::Expect(register) => p.expect_reply(*register),
+        }
+    }
+    GENERAL_ONLY.with(|g| g.set(false));
+    (out, *p.stats(), p.lock())
+}
+
+#[test]
+fn the_short_ways_decide_as_the_general_judgement_on_noisy_streams_of_every_count_model() {
+    let cases: u64 = std::env::var("SHORTCUT_CASES")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(2_000);
+    let mut frames = 0;
+    for seed in 0..cases {
+        let ops = stream(seed);
+        let general = run(&ops, Way::General, seed);
+        frames += general.0.len();
+        for way in [Way::Push, Way::Slices, Way::Frames] {
+            let got = run(&ops, way, seed);
+            assert!(
+                got == general,
+                "seed {seed}, {way:?}: {} frames, general {}; first difference at {:?}\n{:?}\n{:?}",
+                got.0.len(),
+                general.0.len(),
+                got.0.iter().zip(&general.0).position(|(a, b)| a != b),
+                got.1,
+                general.1,
+            );
+        }
+    }
+    // The streams are not empty of frames: the comparison is not vacuous.
+    assert!(frames > 100 * cases as usize, "{frames} frames");
+}
