@@ -9,6 +9,7 @@
 use super::*;
 use crate::{Battery, Encoders, Imu, Reply};
 use std::cell::Cell;
+use std::vec;
 use std::vec::Vec;
 
 std::thread_local! {
@@ -50,99 +51,140 @@ enum Op {
     Expect(Option<Register>),
 }
 
-/// One board stream: telemetry at the board's rates with replies, under one of the count
-/// models A10 allows, through a channel that substitutes, drops and inserts bytes at `rate`,
-/// quiet lines between bursts (and, rarely, inside a frame), and `expect_reply` calls.
-fn stream(seed: u64) -> Vec<Op> {
-    let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
-    let model = rng.below(5);
-    let step = [1, 1, 3, 7, 1][model as usize] as u8;
-    let rate = [0.0, 1e-3, 1e-2, 3e-2][rng.below(4) as usize];
-    let mut counts = [rng.next() as u8; 3];
-    let mut shared = counts[0];
-    let mut ops = Vec::new();
-    let mut burst = Vec::new();
-    let start = rng.below(40) as usize;
-    for tick in 0..(60 + rng.below(140)) {
-        let mut frames: Vec<Downlink> = Vec::new();
-        let mut count = |stream: usize, rng: &mut Rng| -> u8 {
-            match model {
-                // One counter shared by all streams, stepping by 1.
-                4 => {
-                    shared = shared.wrapping_add(1);
-                    shared
-                }
-                // A 10 ms tick.
-                0 if rng.chance(0.5) => {
-                    counts[stream].wrapping_add(if stream == 1 { 4 } else { 1 })
-                }
-                _ => {
-                    counts[stream] = counts[stream].wrapping_add(step);
-                    counts[stream]
-                }
-            }
+/// The board's side: its counts under one of the count models A10 allows.
+struct Board {
+    rng: Rng,
+    /// 0: a 10 ms tick; 1, 2, 3: a counter per stream stepping by 1, 3 or 7; 4: one counter
+    /// shared by all streams.
+    model: u64,
+    counts: [u8; 3],
+}
+
+impl Board {
+    fn count(&mut self, stream: usize, tick: u64) -> u8 {
+        let step = [1, 1, 3, 7, 1][self.model as usize];
+        let i = if self.model == 4 { 0 } else { stream };
+        let count = match self.model {
+            0 => self.counts[0].wrapping_add(tick as u8),
+            _ => self.counts[i].wrapping_add(step),
         };
-        let seq = count(0, &mut rng);
-        frames.push(Downlink::Imu(Imu {
-            accel: [rng.value(0), rng.value(0), rng.value(16_384)],
-            gyro: [rng.value(-5), rng.value(-5), rng.value(0)],
+        self.counts[i] = if self.model == 0 {
+            self.counts[i]
+        } else {
+            count
+        };
+        count
+    }
+
+    /// What the board sends in 10 ms `tick`: an IMU frame, every fourth tick an encoder frame,
+    /// every fiftieth a battery frame (more often than the board, for more of them), and at
+    /// times a reply.
+    fn frames(&mut self, tick: u64) -> Vec<Downlink> {
+        let seq = self.count(0, tick);
+        let r = &mut self.rng;
+        let mut frames = vec![Downlink::Imu(Imu {
+            accel: [r.value(0), r.value(0), r.value(16_384)],
+            gyro: [r.value(-5), r.value(-5), r.value(0)],
             seq,
-        }));
-        if tick % 4 == 0 {
-            let seq = count(1, &mut rng);
+        })];
+        if tick.is_multiple_of(4) {
+            let seq = self.count(1, tick);
+            let r = &mut self.rng;
             frames.push(Downlink::Encoders(Encoders {
-                ticks: [rng.value(-5), rng.value(0), rng.value(-4), rng.value(0)],
+                ticks: [r.value(-5), r.value(0), r.value(-4), r.value(0)],
                 seq,
             }));
         }
         if tick % 50 == 7 {
-            let seq = count(2, &mut rng);
+            let seq = self.count(2, tick);
+            let r = &mut self.rng;
             frames.push(Downlink::Battery(Battery {
-                centivolts: 1_100 + rng.below(100) as u16,
-                percent: rng.below(101) as u16,
+                centivolts: 1_100 + r.below(100) as u16,
+                percent: r.below(101) as u16,
                 seq,
             }));
         }
+        frames
+    }
+}
+
+/// The master's side: the bytes it reads, with the calls it makes between them.
+struct Script {
+    rng: Rng,
+    /// Bytes substituted, dropped or inserted, each with this chance a byte.
+    rate: f64,
+    ops: Vec<Op>,
+    burst: Vec<u8>,
+}
+
+impl Script {
+    /// The bytes so far, then `op`.
+    fn then(&mut self, op: Op) {
+        self.ops.push(Op::Bytes(core::mem::take(&mut self.burst)));
+        self.ops.push(op);
+    }
+
+    /// `frame` through the channel; rarely, the line goes quiet inside it.
+    fn send(&mut self, frame: &Downlink) {
+        for byte in frame.encode().as_ref() {
+            if self.rng.chance(self.rate) {
+                match self.rng.below(3) {
+                    0 => self.burst.push(self.rng.next() as u8),
+                    1 => {}
+                    _ => self.burst.extend([*byte, self.rng.next() as u8]),
+                }
+            } else {
+                self.burst.push(*byte);
+            }
+            if self.rng.chance(0.002) {
+                let ms = 1 + self.rng.below(30) as u32;
+                self.then(Op::Quiet(ms));
+            }
+        }
+    }
+}
+
+/// One board stream: telemetry at the board's rates with replies, through a channel that
+/// substitutes, drops and inserts bytes, quiet lines between bursts (and, rarely, inside a
+/// frame), `expect_reply` calls, and a capture that starts anywhere.
+fn stream(seed: u64) -> Vec<Op> {
+    let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+    let mut board = Board {
+        model: rng.below(5),
+        counts: [rng.next() as u8, rng.next() as u8, rng.next() as u8],
+        rng: Rng(rng.next() | 1),
+    };
+    let mut master = Script {
+        rate: [0.0, 1e-3, 1e-2, 3e-2][rng.below(4) as usize],
+        rng: Rng(rng.next() | 1),
+        ops: Vec::new(),
+        burst: Vec::new(),
+    };
+    for tick in 0..(60 + rng.below(140)) {
+        let mut frames = board.frames(tick);
         if rng.chance(0.08) {
             let register = Register::ALL[rng.below(Register::ALL.len() as u64) as usize];
             if rng.chance(0.6) {
-                ops.push(Op::Bytes(core::mem::take(&mut burst)));
-                ops.push(Op::Expect(Some(register)));
+                master.then(Op::Expect(Some(register)));
             }
             frames.push(Downlink::Reply(Reply {
                 code: register.reply_code(),
-                value: rng.value(-5) as u16 as u32,
+                value: u32::from(rng.value(-5) as u16),
             }));
         }
-        for frame in frames {
-            for byte in frame.encode().as_ref() {
-                if rng.chance(rate) {
-                    match rng.below(3) {
-                        0 => burst.push(rng.next() as u8),
-                        1 => {}
-                        _ => burst.extend([*byte, rng.next() as u8]),
-                    }
-                } else {
-                    burst.push(*byte);
-                }
-                if rng.chance(0.002) {
-                    ops.push(Op::Bytes(core::mem::take(&mut burst)));
-                    ops.push(Op::Quiet(1 + rng.below(30) as u32));
-                }
-            }
+        for frame in &frames {
+            master.send(frame);
         }
         if rng.chance(0.3) {
-            ops.push(Op::Bytes(core::mem::take(&mut burst)));
-            ops.push(Op::Quiet(1 + rng.below(12) as u32));
+            master.then(Op::Quiet(1 + rng.below(12) as u32));
         }
         if rng.chance(0.05) {
-            ops.push(Op::Bytes(core::mem::take(&mut burst)));
-            ops.push(Op::Expect(None));
+            master.then(Op::Expect(None));
         }
     }
-    ops.push(Op::Bytes(burst));
-    ops.push(Op::Quiet(5));
-    // A capture that starts anywhere: the first bytes cut off.
+    master.then(Op::Quiet(5));
+    let mut ops = master.ops;
+    let start = rng.below(40) as usize;
     if let Some(Op::Bytes(first)) = ops
         .iter_mut()
         .find(|op| matches!(op, Op::Bytes(b) if !b.is_empty()))
