@@ -2335,10 +2335,11 @@ fn v2020_from_a_quiet_line_every_frame_whatever_the_step() {
     // lost the first (steps 8, 9, 10, 12 lost nothing; 7, 11, 13, 14, 17 … lost the first):
     // no count read as continuing or near before a step was learnt, and the chain after a quiet
     // line re-based on far counts without ever vouching. Under one counter shared by IMU and
-    // encoder frames stepping by 7 (or 11, 13, 20 …), the first five frames were lost. Every
-    // step a count may take (1 to 127) is tried; the quiet line is reported once, before the
-    // first byte.
-    for step in 1u8..=127 {
+    // encoder frames stepping by 7 (or 11, 13, 20 …), the first five frames were lost. A count
+    // stepping down (by 255, or any step from 128 on) got no frame out at all, ever (a second
+    // outside attack). Every step a count may take (1 to 255) is tried; the quiet line is
+    // reported once, before the first byte.
+    for step in 1u8..=255 {
         let sent: Vec<Downlink> = (0..20u8)
             .map(|i| Downlink::Imu(imu(i.wrapping_mul(step))))
             .collect();
