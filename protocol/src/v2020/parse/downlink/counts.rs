@@ -158,6 +158,16 @@ impl Counts {
         self.steps.get(i)?.iter().position(|s| s.delta == delta)
     }
 
+    /// Whether `delta` divides one of stream `i`'s learnt steps (a shared counter steps a stream
+    /// by multiples of one step).
+    fn divides_a_step(&self, i: usize, delta: u8) -> bool {
+        self.steps.get(i).is_some_and(|steps| {
+            steps
+                .iter()
+                .any(|s| s.hits > 0 && s.delta.checked_rem(delta) == Some(0))
+        })
+    }
+
     /// Stream `i`'s smallest learnt step (1 if none).
     fn smallest_step(&self, i: usize) -> u8 {
         self.steps
@@ -255,13 +265,19 @@ impl Counts {
         Rel::Far
     }
 
-    /// Whether `count` is one step on from `stream`'s remembered far count.
+    /// Whether `count` is one step on from `stream`'s remembered far count: a learnt step, or
+    /// the step that far count took from the count before it, seen again on a line that lost
+    /// nothing (a shared counter steps the IMU by 4 across an encoder frame, then by 2: the
+    /// 2 is far until it is seen twice).
     fn continues_alt(&self, stream: Stream, count: u8) -> bool {
         let i = stream.index();
         let Some(Some(alt)) = self.alt.get(i).copied() else {
             return false;
         };
         let delta = count.wrapping_sub(alt);
+        if delta != 0 && self.alt_step.get(i) == Some(&delta) && self.divides_a_step(i, delta) {
+            return true;
+        }
         if !self.has_steps(stream) {
             return (1..=FIRST_STEP_MAX).contains(&delta);
         }
@@ -540,6 +556,29 @@ mod tests {
         // The step of 6 is learnt: the next such frame continues.
         assert_eq!(c.rel(Stream::Encoders, 27, 0), Rel::Continues);
         assert_eq!(c.rel(Stream::Encoders, 26, 0), Rel::Continues);
+    }
+
+    #[test]
+    fn a_far_count_whose_step_comes_again_and_divides_a_learnt_one_is_followed() {
+        // One counter shared by IMU and encoder frames, stepping by 2: the IMU steps by 4
+        // across an encoder frame, which is learnt first, then by 2 (found by an outside
+        // attack: the 2 was never learnt, and an IMU frame ending `FF FA` was then thrown away).
+        let mut c = seen(Stream::Imu, &[240, 244]);
+        assert_eq!(c.rel(Stream::Imu, 246, 0), Rel::Far);
+        // Not believed, so the stream moves on by its smallest step (4): to 248.
+        c.skip(Stream::Imu, 246);
+        // 248 is 246 plus the same 2 again: taken (a chain believed it), the far count was
+        // real, and 2 is learnt.
+        c.take(Stream::Imu, 248, true);
+        assert!(c.is_step(Stream::Imu, 2));
+        assert_eq!(c.rel(Stream::Imu, 250, 0), Rel::Continues);
+        // A step seen twice that divides no learnt step teaches nothing (header-byte payloads
+        // make such pairs): 3 is no divisor of 4.
+        let mut c = seen(Stream::Imu, &[240, 244]);
+        c.skip(Stream::Imu, 247);
+        c.take(Stream::Imu, 250, true);
+        assert!(!c.is_step(Stream::Imu, 3));
+        assert_ne!(c.rel(Stream::Imu, 253, 0), Rel::Continues);
     }
 
     #[test]
