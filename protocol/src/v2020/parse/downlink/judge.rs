@@ -410,6 +410,11 @@ impl DownlinkParser {
             Need::Now => Ok(true),
             Need::Never => Ok(false),
             Need::Follow => followed(buf, len, quiet).ok_or(1),
+            Need::Quiet => match buf.get(len..) {
+                Some([]) | None if quiet => Ok(true),
+                Some([]) | None => Err(1),
+                Some(_) => Ok(false),
+            },
             Need::Chain(rule) => self.chain(buf, &frame, len, rule, quiet),
         };
         match taken {

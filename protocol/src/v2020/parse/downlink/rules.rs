@@ -126,6 +126,8 @@ pub enum Need {
     Now,
     /// A header (or a quiet line) right after it.
     Follow,
+    /// The quiet line right after it, and nothing else.
+    Quiet,
     /// A chain of frames after it that vouches for it.
     Chain(Walk),
     /// Never: drop its first byte.
@@ -158,7 +160,7 @@ const VERIFY_ONCE: Need = Need::Chain(Walk {
 /// its count against the line's, what follows it), and the less sure its place, the more of
 /// what follows must vouch.
 pub const fn decide(start: Start, f: Facts) -> (u8, Need) {
-    use Need::{Follow, Never, Now};
+    use Need::{Follow, Never, Now, Quiet};
     use Rel::{Continues, Far, Near, Unknown};
     use Start::{Hunting, Locked, Resynced, Tentative};
     let hunting = matches!(start, Hunting);
@@ -166,7 +168,10 @@ pub const fn decide(start: Start, f: Facts) -> (u8, Need) {
     match f.seen {
         // 14. Hunting, its bytes hold a real frame it cannot be (the scan reaches that next).
         Seen::Telemetry(_) if hunting && f.nested => (14, Never),
-        // 15. A far count that is a header's second byte: a cut frame running into the next.
+        // 15. A far count that is a header's second byte: a cut frame running into the next,
+        //     unless, on a boundary not found hunting, the line goes quiet right after it (a
+        //     cut frame would have the rest of the next frame after it, not the quiet).
+        Seen::Telemetry(Far) if f.cut && matches!(start, Locked | Tentative) => (15, Quiet),
         Seen::Telemetry(Far) if f.cut => (15, Never),
         // 1. On a boundary, the count continues: taken on its last byte.
         Seen::Telemetry(Continues) if !hunting => (1, Now),
@@ -373,13 +378,16 @@ mod tests {
     }
 
     #[test]
-    fn row15_a_far_count_that_is_the_next_headers_second_byte_is_never_taken() {
+    fn row15_a_far_count_that_is_the_next_headers_second_byte_needs_the_quiet_line() {
         let cut = Facts {
             cut: true,
             ..telemetry(Far)
         };
-        for start in [Hunting, Tentative, Locked, Resynced] {
+        for start in [Hunting, Resynced] {
             assert_eq!(decide(start, cut), (15, Need::Never));
+        }
+        for start in [Tentative, Locked] {
+            assert_eq!(decide(start, cut), (15, Need::Quiet));
         }
     }
 }
