@@ -49,6 +49,11 @@ struct Walk<'a> {
     shared: Option<(u8, u8, u8)>,
     /// (Exact) a frame of the chain already passed over.
     skipped: bool,
+    /// The streams whose count is, last, one a frame passed over gave (a bit per stream).
+    passed_over: u8,
+    /// A frame of the candidate's own stream was a link (not passed over): its count, not the
+    /// candidate's, is the one the stream's next frames continue.
+    own_linked: bool,
 }
 
 impl<'a> Walk<'a> {
@@ -82,6 +87,8 @@ impl<'a> Walk<'a> {
             own_step: None,
             shared: frame.seq().map(|seq| (seq, 0, 0)),
             skipped: false,
+            passed_over: 0,
+            own_linked: false,
         }
     }
 
@@ -215,12 +222,26 @@ impl<'a> Walk<'a> {
         }
         // A frame whose count byte is the second byte of a telemetry header (its last two
         // bytes are one: a cut frame running into the next one, row 15) is no evidence: passed
-        // over.
+        // over. Unless, in a chain where any stream vouches, its count continues its stream
+        // exactly from a count that neither a frame passed over nor the candidate gave (an IMU
+        // frame whose gyro Z reads -1 and whose count is `FA`..`FC` ends so; a cut frame's
+        // `FA` must not be what the next lookalike's `FB` continues).
+        let bit = 1u8 << stream.index();
         if self.parser.ends_with_a_header(next, at) {
+            if matches!(self.chain, Chain::Verify | Chain::Rebase)
+                && self.passed_over & bit == 0
+                && (self.own != Some(stream) || self.own_linked)
+                && self.counts.rel(stream, seq, at) == Rel::Continues
+            {
+                return Break(Ok(true));
+            }
+            self.passed_over |= bit;
             self.counts.take(stream, seq, false);
             self.shared = None;
             return Continue(());
         }
+        self.passed_over &= !bit;
+        self.own_linked |= self.own == Some(stream);
         if self.shared_in_step(stream, seq) || self.rebase_in_step(stream, seq) {
             return Break(Ok(true));
         }
