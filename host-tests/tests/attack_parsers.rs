@@ -2612,3 +2612,46 @@ fn v2020_two_frames_ending_like_headers_in_a_row_make_no_false_frame() {
     got.extend(quiet(&mut p, 5));
     assert_eq!(got, sent);
 }
+
+#[test]
+fn v2020_a_replys_value_starting_like_a_header_makes_no_false_frame() {
+    // README: "0 false frames on clean streams from any start"; docs/parser.md names this
+    // shape (a frame starting in a reply's value whose tail is the next real frame) as row 14.
+    // One counter shared by all streams stepping by 7; a reply with the value `FF FA 00 00`,
+    // then the board's first encoder frame. The reply, found while hunting, was thrown away;
+    // an IMU frame from its value through the encoder frame ([0, -5, 0], count 1) came out:
+    // row 14 asked the encoder frame's count to fit its stream, which had no count yet. (The
+    // first five frames do not come out: from a quiet line, a shared counter's first IMU frame
+    // followed by another stream's is vouched for by neither rule of frames in step.)
+    let reply = Downlink::Reply(Reply::new(Register::SpeedKp, 0xFFFA_0000));
+    assert_eq!(reply.encode().as_ref(), [0x23, 0x06, 0xFF, 0xFA, 0x00, 0x00]);
+    let battery = Downlink::Battery(Battery {
+        centivolts: 1_173,
+        percent: 73,
+        seq: 243,
+    });
+    let sent = vec![
+        imu_still(236, 0),
+        battery,
+        imu_still(250, 0),
+        reply,
+        enc_still(1),
+        imu_still(8, 0),
+        imu_still(15, 0),
+        imu_still(22, 0),
+        imu_still(29, 0),
+        enc_still(36),
+        imu_still(43, 0),
+    ];
+    for awaited in [false, true] {
+        let mut p = DownlinkParser::new();
+        let mut got = quiet(&mut p, 5);
+        if awaited {
+            p.expect_reply(Some(Register::SpeedKp));
+        }
+        got.extend(p.frames(&bytes_of(&sent)));
+        got.extend(quiet(&mut p, 5));
+        let false_frames: Vec<&Downlink> = got.iter().filter(|f| !sent.contains(f)).collect();
+        assert!(false_frames.is_empty(), "awaited {awaited}: {false_frames:?}");
+    }
+}

@@ -188,7 +188,10 @@ impl DownlinkParser {
             .is_some_and(|inner| {
                 inner != outer
                     && Kind::Telemetry(inner).len().saturating_add(off) == len
-                    && matches!(self.counts.rel(inner, seq, off), Rel::Continues | Rel::Near)
+                    && matches!(
+                        self.counts.rel(inner, seq, off),
+                        Rel::Continues | Rel::Near | Rel::Unknown
+                    )
             })
     }
 
