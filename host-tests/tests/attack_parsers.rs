@@ -2624,7 +2624,10 @@ fn v2020_a_replys_value_starting_like_a_header_makes_no_false_frame() {
     // first five frames do not come out: from a quiet line, a shared counter's first IMU frame
     // followed by another stream's is vouched for by neither rule of frames in step.)
     let reply = Downlink::Reply(Reply::new(Register::SpeedKp, 0xFFFA_0000));
-    assert_eq!(reply.encode().as_ref(), [0x23, 0x06, 0xFF, 0xFA, 0x00, 0x00]);
+    assert_eq!(
+        reply.encode().as_ref(),
+        [0x23, 0x06, 0xFF, 0xFA, 0x00, 0x00]
+    );
     let battery = Downlink::Battery(Battery {
         centivolts: 1_173,
         percent: 73,
@@ -2652,6 +2655,9 @@ fn v2020_a_replys_value_starting_like_a_header_makes_no_false_frame() {
         got.extend(p.frames(&bytes_of(&sent)));
         got.extend(quiet(&mut p, 5));
         let false_frames: Vec<&Downlink> = got.iter().filter(|f| !sent.contains(f)).collect();
-        assert!(false_frames.is_empty(), "awaited {awaited}: {false_frames:?}");
+        assert!(
+            false_frames.is_empty(),
+            "awaited {awaited}: {false_frames:?}"
+        );
     }
 }
