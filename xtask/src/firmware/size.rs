@@ -93,14 +93,19 @@ pub mod budget {
     /// frames are still coming out wait behind them, an `expect_reply` made then waits until
     /// those frames are out, and the slice path stores and judges where `push` does): 14 024 B;
     /// raised to 14.5 KiB when the bytes behind a chain's frames learnt to keep the state the
-    /// frame before them left (the fuzz target found them left unjudged): 14 360 B.
+    /// frame before them left (the fuzz target found them left unjudged): 14 360 B; 14 776 B
+    /// with what two outside attacks found (frames in step vouch after a quiet line and for a
+    /// count stepping down; a step seen twice that divides a learnt one; row 15's quiet line; a
+    /// frame passed over that continues its stream exactly).
     pub const PROTOCOL_CEILING: u64 = 14 * 1024 + 512;
     /// Hardware boards' budgets, by directory: (flash, static RAM), a little above what each
     /// measured when it was added (a regression guard; the ESP32-C3's RAM counts the 3 KiB of
     /// code esp-hal runs from its SRAM).
     pub const BOARDS: [(&str, u64, u64); 3] = [
         ("esp32c3", 70 * 1024, 5 * 1024),
-        ("nrf52840", 48 * 1024, 4 * 1024),
+        // (Raised from 48 KiB with the parser's rules the outside attacks asked for: 48 900 →
+        // 49 340 B.)
+        ("nrf52840", 49 * 1024, 4 * 1024),
         // (Raised from 50 KiB with the parsers' ceiling above: 50 916 → 51 544 B.)
         ("stm32-dma", 51 * 1024, 4 * 1024),
     ];
