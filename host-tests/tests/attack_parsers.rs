@@ -2335,10 +2335,11 @@ fn v2020_from_a_quiet_line_every_frame_whatever_the_step() {
     // lost the first (steps 8, 9, 10, 12 lost nothing; 7, 11, 13, 14, 17 … lost the first):
     // no count read as continuing or near before a step was learnt, and the chain after a quiet
     // line re-based on far counts without ever vouching. Under one counter shared by IMU and
-    // encoder frames stepping by 7 (or 11, 13, 20 …), the first five frames were lost. Every
-    // step on (1 to 127) is tried; the quiet line is reported once, before the first byte. (A
-    // count stepping down: the ignored test below.)
-    for step in 1u8..=127 {
+    // encoder frames stepping by 7 (or 11, 13, 20 …), the first five frames were lost. A count
+    // stepping down (by 255, or any step from 128 on) got no frame out at all, ever (a second
+    // outside attack). Every step a count may take (1 to 255) is tried; the quiet line is
+    // reported once, before the first byte.
+    for step in 1u8..=255 {
         let sent: Vec<Downlink> = (0..20u8)
             .map(|i| Downlink::Imu(imu(i.wrapping_mul(step))))
             .collect();
@@ -2688,17 +2689,4 @@ fn v2020_a_cold_start_on_header_byte_payloads_makes_no_false_frame() {
     got.extend(quiet(&mut p, 5));
     let false_frames: Vec<&Downlink> = got.iter().filter(|f| !sent.contains(f)).collect();
     assert!(false_frames.is_empty(), "{false_frames:?}");
-}
-
-#[test]
-#[ignore = "found by the outside attack: a count stepping down (by 128 or more) gets no frame out, ever; vouching for each such frame by the frames in step after it let false frames through at 1e-3 byte errors (up to 2 278 per million on header-byte payloads)"]
-fn v2020_a_count_stepping_down_gets_its_frames_out() {
-    // A10: "a counter per stream by 1, by k"; a count that steps by 255 (down by one) is one.
-    // From a quiet line, 40 IMU frames at rest, counts 100, 99, 98 …: none comes out.
-    let sent: Vec<Downlink> = (0..40u8).map(|i| imu_still(100 - i, 0)).collect();
-    let mut p = DownlinkParser::new();
-    let mut got = quiet(&mut p, 5);
-    got.extend(p.frames(&bytes_of(&sent)));
-    got.extend(quiet(&mut p, 5));
-    assert_eq!(got, sent);
 }

@@ -511,9 +511,9 @@ impl DownlinkParser {
 }
 
 /// Whether `delta` is a step wider than a stream's first step may be ([`FIRST_STEP_MAX`]) and
-/// still a step on (at most 127: a count stepping down, by 128 or more, is no step on).
+/// still a step on (any up to 255: a count stepping down by one steps by 255).
 fn wide(delta: u8) -> bool {
-    (FIRST_STEP_MAX.saturating_add(1)..=127).contains(&delta)
+    delta > FIRST_STEP_MAX
 }
 
 /// Not decided: `more` bytes are needed, unless the window is already full.
