@@ -30,7 +30,6 @@ struct Walk<'a> {
     parser: &'a DownlinkParser,
     buf: &'a [u8],
     rule: Rule,
-    chain: Chain,
     quiet: bool,
     /// The counts as the chain so far leaves them (the candidate's own taken).
     counts: Counts,
@@ -49,8 +48,16 @@ struct Walk<'a> {
     shared: Option<(u8, u8, u8)>,
     /// (Exact) a frame of the chain already passed over.
     skipped: bool,
+    /// What the frames passed over (their count a header's second byte) left.
+    passed: Passed,
+}
+
+/// What the frames a chain passed over left, for a later one to vouch only from a count that
+/// neither they nor the candidate gave.
+#[derive(Default)]
+struct Passed {
     /// The streams whose count is, last, one a frame passed over gave (a bit per stream).
-    passed_over: u8,
+    streams: u8,
     /// A frame of the candidate's own stream was a link (not passed over): its count, not the
     /// candidate's, is the one the stream's next frames continue.
     own_linked: bool,
@@ -78,7 +85,6 @@ impl<'a> Walk<'a> {
             parser,
             buf,
             rule,
-            chain: rule.chain,
             quiet,
             counts,
             own,
@@ -87,8 +93,7 @@ impl<'a> Walk<'a> {
             own_step: None,
             shared: frame.seq().map(|seq| (seq, 0, 0)),
             skipped: false,
-            passed_over: 0,
-            own_linked: false,
+            passed: Passed::default(),
         }
     }
 
@@ -131,7 +136,7 @@ impl<'a> Walk<'a> {
             .and_then(|second| stream_of_second(*second))
             .filter(|_| buf.get(pos.wrapping_sub(1)) != Some(&sync));
         match lost_first {
-            Some(stream) if self.chain == Chain::Exact && !self.skipped => {
+            Some(stream) if self.rule.chain == Chain::Exact && !self.skipped => {
                 let next = pos
                     .saturating_sub(1)
                     .saturating_add(Kind::Telemetry(stream).len());
@@ -170,7 +175,7 @@ impl<'a> Walk<'a> {
         {
             return Break(Ok(false));
         }
-        if self.chain == Chain::Exact {
+        if self.rule.chain == Chain::Exact {
             self.exact_link(&next, at, end)?;
             self.skipped = true;
         } else {
@@ -228,20 +233,20 @@ impl<'a> Walk<'a> {
         // `FA` must not be what the next lookalike's `FB` continues).
         let bit = 1u8 << stream.index();
         if self.parser.ends_with_a_header(next, at) {
-            if matches!(self.chain, Chain::Verify | Chain::Rebase)
-                && self.passed_over & bit == 0
-                && (self.own != Some(stream) || self.own_linked)
+            if matches!(self.rule.chain, Chain::Verify | Chain::Rebase)
+                && self.passed.streams & bit == 0
+                && (self.own != Some(stream) || self.passed.own_linked)
                 && self.counts.rel(stream, seq, at) == Rel::Continues
             {
                 return Break(Ok(true));
             }
-            self.passed_over |= bit;
+            self.passed.streams |= bit;
             self.counts.take(stream, seq, false);
             self.shared = None;
             return Continue(());
         }
-        self.passed_over &= !bit;
-        self.own_linked |= self.own == Some(stream);
+        self.passed.streams &= !bit;
+        self.passed.own_linked |= self.own == Some(stream);
         if self.shared_in_step(stream, seq) || self.rebase_in_step(stream, seq) {
             return Break(Ok(true));
         }
@@ -253,7 +258,7 @@ impl<'a> Walk<'a> {
                 self.counts.take(stream, seq, false);
                 Continue(())
             }
-            Rel::Far if matches!(self.chain, Chain::Rebase | Chain::Restart) => {
+            Rel::Far if matches!(self.rule.chain, Chain::Rebase | Chain::Restart) => {
                 self.counts.take(stream, seq, false);
                 Continue(())
             }
@@ -267,7 +272,9 @@ impl<'a> Walk<'a> {
     /// 5 or more, whose counts no chain reads as continuing before a step is learnt, is vouched
     /// for as hunting vouches for it (row 9).
     fn rebase_in_step(&mut self, stream: Stream, seq: u8) -> bool {
-        if self.chain != Chain::Rebase || self.own != Some(stream) || self.counts.has_steps(stream)
+        if self.rule.chain != Chain::Rebase
+            || self.own != Some(stream)
+            || self.counts.has_steps(stream)
         {
             return false;
         }
@@ -285,7 +292,7 @@ impl<'a> Walk<'a> {
     /// Whether the chain asks for frames in step to vouch for a candidate of `stream`: an Own
     /// chain while the stream has no step learnt, a Restart chain always.
     fn in_step_needed(&self, stream: Stream) -> bool {
-        match self.chain {
+        match self.rule.chain {
             Chain::Restart => true,
             Chain::Own => !self.counts.has_steps(stream),
             _ => false,
@@ -313,7 +320,8 @@ impl<'a> Walk<'a> {
             return false;
         }
         let delta = seq.wrapping_sub(last);
-        let fits = (1..=FIRST_STEP_MAX).contains(&delta) || self.chain == Chain::Own && wide(delta);
+        let fits =
+            (1..=FIRST_STEP_MAX).contains(&delta) || self.rule.chain == Chain::Own && wide(delta);
         if seen > 0 && delta != step || !fits {
             self.shared = None;
             return false;
@@ -343,7 +351,7 @@ impl<'a> Walk<'a> {
     /// [`IN_STEP`] frames equally spaced (sensor bytes drift slowly, and payloads repeat a
     /// frame's length apart, so false frames' "counts" can move in small steps for a while).
     fn may_vouch(&mut self, stream: Stream, seq: u8) -> Step<bool> {
-        let own_only = matches!(self.chain, Chain::Own | Chain::Restart);
+        let own_only = matches!(self.rule.chain, Chain::Own | Chain::Restart);
         let vouches = !own_only || self.own == Some(stream);
         if !(vouches && self.in_step_needed(stream)) {
             return Continue(vouches);
@@ -353,7 +361,7 @@ impl<'a> Walk<'a> {
             // In step by more than a stream's first step may be (a shared counter stepping by
             // 5 or more): the count will not read as continuing, the frames in step vouch.
             Some((step, seen)) if step == delta && seen >= IN_STEP - 1 => {
-                if self.chain == Chain::Own && wide(delta) {
+                if self.rule.chain == Chain::Own && wide(delta) {
                     Break(Ok(true))
                 } else {
                     Continue(true)
