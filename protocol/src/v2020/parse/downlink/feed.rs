@@ -94,6 +94,12 @@ impl DownlinkParser {
             self.append(&[byte]);
         }
         if ready.is_some() {
+            if self.behind.len == 0 && !self.drain && !full && self.missing > 1 && short_ways() {
+                // The frame left a wait that this byte does not end: polled first, the byte
+                // would only have been stored (`push`'s fast path), and it is.
+                self.missing = self.missing.wrapping_sub(1);
+                return ready;
+            }
             // The byte waits behind what is left of the window (if anything): judged after
             // it, at the next call, as if the frame had been polled out before the byte came.
             if self.behind.len == 0 {
