@@ -25,9 +25,11 @@ impl<const N: usize> Window<N> {
 
     #[inline]
     pub(crate) fn as_slice(&self) -> &[u8] {
-        self.bytes
-            .get(usize::from(self.start)..usize::from(self.end))
-            .unwrap_or(&[])
+        // (Clamped rather than checked: `start` ≤ `end` ≤ `N` always holds, and the clamps
+        // cost less than a check with a fallback.)
+        let end = usize::from(self.end).min(N);
+        let start = usize::from(self.start).min(end);
+        self.bytes.get(start..end).unwrap_or(&[])
     }
 
     #[inline]
