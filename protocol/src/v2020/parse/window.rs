@@ -82,11 +82,13 @@ impl<const N: usize> Window<N> {
 
     /// Moves the bytes kept to the front.
     pub(crate) fn compact(&mut self) {
-        let (start, end) = (usize::from(self.start), usize::from(self.end));
-        let old = self.bytes;
-        if let Some(src) = old.get(start..end) {
-            if let Some(dst) = self.bytes.get_mut(..src.len()) {
-                dst.copy_from_slice(src);
+        // (Byte by byte, forwards: no copy of the whole buffer first.)
+        let end = usize::from(self.end).min(N);
+        let start = usize::from(self.start).min(end);
+        for from in start..end {
+            let byte = self.bytes.get(from).copied().unwrap_or(0);
+            if let Some(to) = self.bytes.get_mut(from.wrapping_sub(start)) {
+                *to = byte;
             }
         }
         self.end = self.end.saturating_sub(self.start);
