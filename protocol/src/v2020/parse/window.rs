@@ -8,6 +8,7 @@
 /// not the bytes; they move to the front only when the end is reached. Nothing here can panic.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(C)]
 pub(crate) struct Window<const N: usize> {
     bytes: [u8; N],
     start: u8,

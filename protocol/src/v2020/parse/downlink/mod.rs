@@ -127,9 +127,14 @@ pub enum Lock {
 /// ```
 #[derive(Clone, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+// (Laid out in this order, the window's bytes first: `push`'s fast path, inlined into the
+// caller's loop, then stores a byte at the parser's address plus `end`, with no offset to add.)
+#[repr(C)]
 pub struct DownlinkParser {
     buf: Window<WINDOW>,
     counts: Counts,
+    /// Bytes consumed since the last frame taken (saturating).
+    since_frame: u16,
     lock: Lock,
     /// The reply code awaited, if any.
     expect: Option<u8>,
@@ -141,8 +146,6 @@ pub struct DownlinkParser {
     drain: bool,
     /// Bytes stored behind frames not yet out.
     behind: Behind,
-    /// Bytes consumed since the last frame taken (saturating).
-    since_frame: u16,
     /// Bytes to store before anything can be decided (0 or 1: none; always 0 while `drain`):
     /// the rest of the frame whose header is at the front of the window, once judging it has
     /// needed more; or, right after a frame taken by row 1 with the window empty, the next
