@@ -66,6 +66,7 @@ struct Step {
 /// What the counts have taught the parser, per stream.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(align(4))]
 pub struct Counts {
     /// Bit `i`: stream `i` has a count.
     known: u8,

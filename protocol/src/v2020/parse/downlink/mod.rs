@@ -132,9 +132,9 @@ pub enum Lock {
 #[repr(C)]
 pub struct DownlinkParser {
     buf: Window<WINDOW>,
-    counts: Counts,
     /// Bytes consumed since the last frame taken (saturating).
     since_frame: u16,
+    counts: Counts,
     lock: Lock,
     /// The reply code awaited, if any.
     expect: Option<u8>,
