@@ -70,14 +70,14 @@ impl<const N: usize> Window<N> {
         if usize::from(self.end).saturating_add(bytes.len()) > N && self.start > 0 {
             self.compact();
         }
-        let end = usize::from(self.end);
-        let taken = bytes.len().min(N.saturating_sub(end));
-        let to = end.saturating_add(taken);
-        match (self.bytes.get_mut(end..to), bytes.get(..taken)) {
-            (Some(dst), Some(src)) => dst.copy_from_slice(src),
-            _ => return 0,
+        let end = usize::from(self.end).min(N);
+        // (A byte at a time: a frame's few bytes, and no `memcpy` to link in.)
+        let mut taken = 0;
+        for (to, from) in self.bytes.get_mut(end..).unwrap_or(&mut []).iter_mut().zip(bytes) {
+            *to = *from;
+            taken += 1;
         }
-        self.end = u8::try_from(to).unwrap_or(self.end);
+        self.end = u8::try_from(end.saturating_add(taken)).unwrap_or(self.end);
         taken
     }
 
