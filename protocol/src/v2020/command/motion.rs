@@ -60,17 +60,17 @@ pub const DUTY_FULL_SCALE: u16 = 10_000;
 fn encode_body(x: i32, y: i32, z: i32, flags: u8) -> [u8; Velocity::LEN] {
     let mut buf = [0u8; Velocity::LEN];
     let mut direction = flags;
-    for (value, at, reverse_bit) in [
-        (x, field::X, dir::X_REVERSE),
-        (y, field::Y, dir::Y_REVERSE),
-        (z, field::Z, dir::Z_REVERSE),
-    ] {
+    // (Written out three times: each field's offset a constant, its bytes two stores.)
+    let mut put = |value: i32, at: usize, reverse_bit: u8| {
         let (magnitude, reverse) = wire::split_signed(value, u16::MAX);
         wire::put_u16(&mut buf, at, magnitude);
         if reverse && magnitude != 0 {
             direction |= reverse_bit;
         }
-    }
+    };
+    put(x, field::X, dir::X_REVERSE);
+    put(y, field::Y, dir::Y_REVERSE);
+    put(z, field::Z, dir::Z_REVERSE);
     wire::put(&mut buf, field::HEADER, &HEADER);
     wire::put_u8(&mut buf, field::MODE, mode::VELOCITY);
     wire::put_u8(&mut buf, field::VELOCITY_DIR, direction);
@@ -421,15 +421,21 @@ impl Motors {
     pub fn encode(&self) -> [u8; Self::LEN] {
         let mut buf = [0u8; Self::LEN];
         let mut direction = self.kept;
-        for ((&value, at), reverse_bit) in
-            self.values.iter().zip(field::MOTOR).zip(dir::MOTOR_REVERSE)
-        {
+        // (Written out four times, as `encode_body` writes its three.)
+        let mut put = |value: i32, at: usize, reverse_bit: u8| {
             let (magnitude, reverse) = wire::split_signed(value, u16::MAX);
             wire::put_u16(&mut buf, at, magnitude);
             if reverse && magnitude != 0 {
                 direction |= reverse_bit;
             }
-        }
+        };
+        let [v0, v1, v2, v3] = self.values;
+        let [at0, at1, at2, at3] = field::MOTOR;
+        let [r0, r1, r2, r3] = dir::MOTOR_REVERSE;
+        put(v0, at0, r0);
+        put(v1, at1, r1);
+        put(v2, at2, r2);
+        put(v3, at3, r3);
         wire::put(&mut buf, field::HEADER, &HEADER);
         wire::put_u8(&mut buf, field::MODE, self.control.mode());
         wire::put_u8(&mut buf, field::MOTORS_DIR, direction);
