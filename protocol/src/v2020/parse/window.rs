@@ -73,7 +73,13 @@ impl<const N: usize> Window<N> {
         let end = usize::from(self.end).min(N);
         // (A byte at a time: a frame's few bytes, and no `memcpy` to link in.)
         let mut taken = 0;
-        for (to, from) in self.bytes.get_mut(end..).unwrap_or(&mut []).iter_mut().zip(bytes) {
+        for (to, from) in self
+            .bytes
+            .get_mut(end..)
+            .unwrap_or(&mut [])
+            .iter_mut()
+            .zip(bytes)
+        {
             *to = *from;
             taken += 1;
         }
