@@ -54,15 +54,7 @@ pub(crate) fn put_u8(buf: &mut [u8], at: usize, value: u8) {
 /// Writes a big-endian `u16` at `at`.
 #[inline]
 pub(crate) fn put_u16(buf: &mut [u8], at: usize, value: u16) {
-    // (Two stores, not `put`'s loop: with `at` not a constant, the compiler would make that
-    // loop a `memcpy` call, and link `memcpy` into firmware that has no other use for it.)
-    let [high, low] = value.to_be_bytes();
-    if let Some(byte) = buf.get_mut(at) {
-        *byte = high;
-    }
-    if let Some(byte) = at.checked_add(1).and_then(|at| buf.get_mut(at)) {
-        *byte = low;
-    }
+    put(buf, at, &value.to_be_bytes());
 }
 
 /// Writes a big-endian `i16` at `at`.
