@@ -24,13 +24,20 @@ impl<const N: usize> Window<N> {
         }
     }
 
-    #[inline]
+    /// The bytes kept. Out of line: most of its callers are off the path every frame takes,
+    /// and each inlined copy costs flash.
+    #[inline(never)]
     pub(crate) fn as_slice(&self) -> &[u8] {
-        // (Clamped rather than checked: `start` ≤ `end` ≤ `N` always holds, and the clamps
-        // cost less than a check with a fallback.)
-        let end = usize::from(self.end).min(N);
-        let start = usize::from(self.start).min(end);
-        self.bytes.get(start..end).unwrap_or(&[])
+        self.kept()
+    }
+
+    /// [`as_slice`](Self::as_slice) inlined, for the few places every frame goes through.
+    #[inline(always)]
+    pub(crate) fn kept(&self) -> &[u8] {
+        self.bytes
+            .get(..usize::from(self.end))
+            .and_then(|kept| kept.get(usize::from(self.start)..))
+            .unwrap_or(&[])
     }
 
     #[inline]

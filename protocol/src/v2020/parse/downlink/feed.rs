@@ -42,7 +42,7 @@ impl DownlinkParser {
     /// [`push_decide`](Self::push_decide).
     #[inline(never)]
     fn push_header(&mut self, byte: u8) -> Option<Downlink> {
-        if let [first] = *self.buf.as_slice() {
+        if let [first] = *self.buf.kept() {
             if let Some(wait) = Kind::from_header(first, byte).and_then(header_wait) {
                 if self.buf.push(byte) {
                     self.missing = wait;

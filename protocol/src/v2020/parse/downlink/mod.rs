@@ -285,7 +285,7 @@ impl DownlinkParser {
                 // bytes the last judgement waits for, all in `bytes`: stored in one copy, and
                 // judged at the last, as `push` judges them. (A byte at most is kept before a
                 // header: the frame fits.)
-                let whole = match (self.buf.as_slice(), bytes) {
+                let whole = match (self.buf.kept(), bytes) {
                     ([], [a, b, ..]) => Kind::from_header(*a, *b).map(Kind::len),
                     ([a], [b, ..]) => {
                         Kind::from_header(*a, *b).map(|kind| kind.len().saturating_sub(1))

@@ -71,7 +71,7 @@ impl DownlinkParser {
         if !short_ways() {
             return self.run(false);
         }
-        let bytes = self.buf.as_slice();
+        let bytes = self.buf.kept();
         if let (&[first, second, ..], Some(&seq)) = (bytes, bytes.last()) {
             if let Some(stream) = telemetry_header(&[first, second]) {
                 if Kind::Telemetry(stream).len() == bytes.len() {
@@ -208,7 +208,7 @@ impl DownlinkParser {
         if self.drain {
             return None;
         }
-        let kept = self.buf.as_slice();
+        let kept = self.buf.kept();
         let (first, second) = match (kept, bytes) {
             ([], [a, b, ..]) | ([a], [b, ..]) | ([a, b, ..], _) => (*a, *b),
             _ => return None,
