@@ -1,13 +1,16 @@
 //! The firmware tasks: `demo` (the bring-up in QEMU), `qemu ELF` (the QEMU board's cargo
-//! runner), `size`, `icount`, and the firmware half of `test` (every board built, the firmware's
-//! no-panic proof, the size budgets, the end-to-end tests in QEMU). Here: the boards and how one
-//! is built; [`mod@qemu`] boots a firmware in QEMU, [`mod@size`] and [`mod@icount`] measure it.
+//! runner), `size`, `icount` (and `icount --profile`), and the firmware half of `test` (every
+//! board built, the firmware's no-panic proof, the size budgets, the end-to-end tests in QEMU).
+//! Here: the boards and how one is built; [`mod@qemu`] boots a firmware in QEMU, [`mod@size`],
+//! [`mod@icount`] and [`mod@profile`] measure it.
 
 mod icount;
+mod profile;
 mod qemu;
 mod size;
 
 pub use icount::icount;
+pub use profile::profile;
 pub use qemu::{demo, qemu};
 pub use size::size;
 

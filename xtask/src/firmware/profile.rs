@@ -1,0 +1,235 @@
+//! `cargo xtask icount --profile`: where the 2020 parser's instructions go on the Cortex-M4's
+//! telemetry mix, by function and by byte.
+//!
+//! The instruction-count binary runs in QEMU with every translated block's instructions and
+//! every block executed logged (`-d in_asm,exec,nochain`). The run's SysTick reads
+//! (`time::cycles`) cut it into its measurements; the first one through the byte path
+//! (`icount::parse_all`) is the telemetry mix through `push`, the figure `cargo xtask icount`
+//! prints. Each block's instructions are charged to the function holding its first address
+//! (the ELF's symbols), and to the byte being fed: a byte starts where `parse_all`'s loop comes
+//! back to its head.
+
+use super::qemu::ensure_qemu;
+use super::{BOARDS, Board, M4, build_board, elf, firmware_target_dir};
+use crate::tools::install_targets;
+use object::{Object, ObjectSymbol, SymbolKind};
+use std::collections::HashMap;
+use std::process::Command;
+
+/// The parser's loop over the mix, and the clock read that starts and ends a measurement.
+const LOOP: &str = "parse_all";
+const CLOCK: &str = "cycles";
+
+/// `cargo xtask icount --profile`.
+pub fn profile() -> Result<(), String> {
+    install_targets(&[M4])?;
+    ensure_qemu()?;
+    let board = Board {
+        target: M4,
+        ..BOARDS[0]
+    };
+    build_board(
+        &board,
+        &["--no-default-features", "--bin", "icount", "--target", M4],
+        &[("DEFMT_LOG", "off")],
+    )?;
+    let elf_path = elf(&board, "icount")?;
+    let log = firmware_target_dir()?.join("icount-profile.log");
+    let status = Command::new("qemu-system-arm")
+        .args(["-machine", "mps2-an386", "-cpu", "cortex-m4"])
+        .args(["-display", "none", "-monitor", "none"])
+        .args(["-semihosting-config", "enable=on,target=native"])
+        .args(["-icount", "shift=0", "-d", "in_asm,exec,nochain", "-D"])
+        .arg(&log)
+        .arg("-kernel")
+        .arg(&elf_path)
+        .stdout(std::process::Stdio::null())
+        .status()
+        .map_err(|e| format!("could not start qemu-system-arm: {e}"))?;
+    if !status.success() {
+        return Err(format!("the profiled run failed ({status})"));
+    }
+    let data = std::fs::read(&elf_path).map_err(|e| format!("{}: {e}", elf_path.display()))?;
+    let functions = Functions::read(&data)?;
+    let text = std::fs::read_to_string(&log).map_err(|e| format!("{}: {e}", log.display()))?;
+    let (sizes, trace) = blocks(&text);
+    let mix = mix_phase(&trace, &functions)?;
+    report(mix, &sizes, &functions);
+    Ok(())
+}
+
+/// The firmware's functions: (start, end, name), sorted.
+struct Functions(Vec<(u64, u64, String)>);
+
+impl Functions {
+    fn read(data: &[u8]) -> Result<Self, String> {
+        let file = object::File::parse(data).map_err(|e| format!("the ELF: {e}"))?;
+        let mut all: Vec<(u64, u64, String)> = file
+            .symbols()
+            .filter(|s| s.kind() == SymbolKind::Text && s.size() > 0)
+            .filter_map(|s| {
+                let name = demangle(s.name().ok()?);
+                let start = s.address() & !1;
+                Some((start, start.saturating_add(s.size()), name))
+            })
+            .collect();
+        all.sort();
+        Ok(Functions(all))
+    }
+
+    /// The function holding `pc`.
+    fn of(&self, pc: u64) -> Option<&str> {
+        let i = self.0.partition_point(|(start, _, _)| *start <= pc);
+        let (start, end, name) = self.0.get(i.checked_sub(1)?)?;
+        (*start <= pc && pc < *end).then_some(name.as_str())
+    }
+
+    /// Whether `pc` is in a function whose name contains `part`.
+    fn is_in(&self, pc: u64, part: &str) -> bool {
+        self.of(pc).is_some_and(|name| name.contains(part))
+    }
+}
+
+/// A legacy-mangled Rust name's path without its hash (`a::b::c`), the name itself otherwise.
+fn demangle(mangled: &str) -> String {
+    let Some(mut rest) = mangled
+        .strip_prefix("_ZN")
+        .and_then(|r| r.strip_suffix('E'))
+    else {
+        return mangled.to_string();
+    };
+    let mut parts = Vec::new();
+    while let Some(digits) = rest.find(|c: char| !c.is_ascii_digit()).filter(|n| *n > 0) {
+        let Ok(len) = rest[..digits].parse::<usize>() else {
+            break;
+        };
+        let Some(part) = rest.get(digits..digits + len) else {
+            break;
+        };
+        if !(part.starts_with('h') && part.len() == 17) {
+            parts.push(
+                part.trim_start_matches('_')
+                    .replace("$LT$", "<")
+                    .replace("$GT$", ">")
+                    .replace("$u20$", " ")
+                    .replace("..", "::"),
+            );
+        }
+        rest = &rest[digits + len..];
+    }
+    parts.join("::")
+}
+
+/// From QEMU's log: each translated block's instruction count by its address, and the
+/// addresses of the blocks executed, in order.
+fn blocks(log: &str) -> (HashMap<u64, u64>, Vec<u64>) {
+    let (mut sizes, mut trace) = (HashMap::new(), Vec::new());
+    let mut current: Option<u64> = None;
+    for line in log.lines() {
+        if line.starts_with("IN:") {
+            current = None;
+        } else if let Some(pc) = line
+            .strip_prefix("0x")
+            .and_then(|l| l.split(':').next())
+            .and_then(|a| u64::from_str_radix(a, 16).ok())
+        {
+            let start = *current.get_or_insert(pc);
+            *sizes.entry(start).or_insert(0) += 1;
+        } else if line.starts_with("Trace") {
+            // "Trace 0: 0x… [00000000/0000abcd/…] …": the block's address is the second field.
+            if let Some(pc) = line
+                .split('[')
+                .nth(1)
+                .and_then(|f| f.split('/').nth(1))
+                .and_then(|a| u64::from_str_radix(a, 16).ok())
+            {
+                trace.push(pc);
+            }
+        }
+    }
+    (sizes, trace)
+}
+
+/// The blocks executed during the first measurement through the byte path.
+fn mix_phase<'t>(trace: &'t [u64], functions: &Functions) -> Result<&'t [u64], String> {
+    trace
+        .split(|pc| functions.is_in(*pc, CLOCK))
+        .find(|phase| phase.iter().any(|pc| functions.is_in(*pc, LOOP)))
+        .ok_or_else(|| "no measurement through the byte path in the log".to_string())
+}
+
+/// Prints the mix's instructions by function, then by byte.
+fn report(mix: &[u64], sizes: &HashMap<u64, u64>, functions: &Functions) {
+    let cost = |pc: &u64| sizes.get(pc).copied().unwrap_or(0);
+    let total: u64 = mix.iter().map(cost).sum();
+    let mut by_function: HashMap<&str, u64> = HashMap::new();
+    for pc in mix {
+        *by_function
+            .entry(functions.of(*pc).unwrap_or("?"))
+            .or_default() += cost(pc);
+    }
+    let mut rows: Vec<_> = by_function.into_iter().collect();
+    rows.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(b.0)));
+    println!("the telemetry mix through `push` on the Cortex-M4: {total} instructions\n");
+    println!("| function | instructions | share |\n|---|---|---|");
+    for (name, n) in rows.iter().take(16) {
+        println!(
+            "| `{name}` | {n} | {:.1} % |",
+            *n as f64 * 100.0 / total as f64
+        );
+    }
+    // The loop's head: its most executed block.
+    let mut in_loop: HashMap<u64, u64> = HashMap::new();
+    for pc in mix.iter().filter(|pc| functions.is_in(**pc, LOOP)) {
+        *in_loop.entry(*pc).or_default() += 1;
+    }
+    let Some(head) = in_loop
+        .into_iter()
+        .max_by_key(|(pc, n)| (*n, *pc))
+        .map(|(pc, _)| pc)
+    else {
+        return;
+    };
+    let mut bytes: Vec<u64> = Vec::new();
+    for pc in mix {
+        if *pc == head || bytes.is_empty() {
+            bytes.push(0);
+        }
+        if let Some(last) = bytes.last_mut() {
+            *last += cost(pc);
+        }
+    }
+    println!(
+        "\n{} bytes; each byte's instructions (the harness's loop included), by what they cost:\n",
+        bytes.len()
+    );
+    println!("| instructions for the byte | bytes | instructions in all |\n|---|---|---|");
+    for (low, high) in [(0, 29), (30, 119), (120, 299), (300, u64::MAX)] {
+        let class: Vec<u64> = bytes
+            .iter()
+            .copied()
+            .filter(|c| (low..=high).contains(c))
+            .collect();
+        let range = if high == u64::MAX {
+            format!("{low} or more")
+        } else {
+            format!("{low}–{high}")
+        };
+        println!(
+            "| {range} | {} | {} |",
+            class.len(),
+            class.iter().sum::<u64>()
+        );
+    }
+    println!("\nby 512-byte stretch of the mix (the first holds the cold start):\n");
+    println!("| bytes | instructions | a byte |\n|---|---|---|");
+    for (i, chunk) in bytes.chunks(512).enumerate() {
+        let sum: u64 = chunk.iter().sum();
+        println!(
+            "| {}–{} | {sum} | {:.1} |",
+            i * 512,
+            i * 512 + chunk.len() - 1,
+            sum as f64 / chunk.len() as f64
+        );
+    }
+}
