@@ -79,7 +79,7 @@ impl<const N: usize> Window<N> {
         }
         let end = usize::from(self.end).min(N);
         // (A byte at a time: a frame's few bytes, and no `memcpy` to link in.)
-        let mut taken = 0;
+        let mut taken = 0usize;
         for (to, from) in self
             .bytes
             .get_mut(end..)
@@ -88,7 +88,7 @@ impl<const N: usize> Window<N> {
             .zip(bytes)
         {
             *to = *from;
-            taken += 1;
+            taken = taken.wrapping_add(1);
         }
         self.end = u8::try_from(end.saturating_add(taken)).unwrap_or(self.end);
         taken
