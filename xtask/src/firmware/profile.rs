@@ -178,27 +178,34 @@ fn report(mix: &[u64], sizes: &HashMap<u64, u64>, functions: &Functions) {
             *n as f64 * 100.0 / total as f64
         );
     }
-    // The loop's head: its most executed block.
+    report_bytes(&per_byte(mix, &cost, functions));
+}
+
+/// Each byte's instructions: a byte starts where the loop comes back to its head (its most
+/// executed block).
+fn per_byte(mix: &[u64], cost: &dyn Fn(&u64) -> u64, functions: &Functions) -> Vec<u64> {
     let mut in_loop: HashMap<u64, u64> = HashMap::new();
     for pc in mix.iter().filter(|pc| functions.is_in(**pc, LOOP)) {
         *in_loop.entry(*pc).or_default() += 1;
     }
-    let Some(head) = in_loop
+    let head = in_loop
         .into_iter()
         .max_by_key(|(pc, n)| (*n, *pc))
-        .map(|(pc, _)| pc)
-    else {
-        return;
-    };
+        .map(|(pc, _)| pc);
     let mut bytes: Vec<u64> = Vec::new();
     for pc in mix {
-        if *pc == head || bytes.is_empty() {
+        if Some(*pc) == head || bytes.is_empty() {
             bytes.push(0);
         }
         if let Some(last) = bytes.last_mut() {
             *last += cost(pc);
         }
     }
+    bytes
+}
+
+/// Prints the bytes by what each cost, then by 512-byte stretch.
+fn report_bytes(bytes: &[u64]) {
     println!(
         "\n{} bytes; each byte's instructions (the harness's loop included), by what they cost:\n",
         bytes.len()
