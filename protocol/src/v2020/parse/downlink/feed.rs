@@ -122,6 +122,14 @@ impl DownlinkParser {
     #[inline(never)]
     pub(super) fn complete_behind(&mut self) -> Option<Downlink> {
         let behind = self.behind.len;
+        if behind == 0 && (self.drain || self.missing == 0) {
+            // Nothing behind: the window judged as it is (the loop below, in short).
+            let frame = self.complete();
+            if !self.drain {
+                self.expect_pending();
+            }
+            return frame;
+        }
         let mut left = behind;
         let mut at = self.buf.hide(left);
         if behind > 0 && self.behind.resume != RESUME_DRAIN {
