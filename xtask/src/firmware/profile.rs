@@ -192,9 +192,10 @@ fn per_byte(mix: &[u64], cost: &dyn Fn(&u64) -> u64, functions: &Functions) -> V
         .into_iter()
         .max_by_key(|(pc, n)| (*n, *pc))
         .map(|(pc, _)| pc);
+    // (What runs before the loop's head is first reached is the parser's setup: not a byte.)
     let mut bytes: Vec<u64> = Vec::new();
     for pc in mix {
-        if Some(*pc) == head || bytes.is_empty() {
+        if Some(*pc) == head {
             bytes.push(0);
         }
         if let Some(last) = bytes.last_mut() {
