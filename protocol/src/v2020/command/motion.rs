@@ -61,20 +61,25 @@ fn encode_body(x: i32, y: i32, z: i32, flags: u8) -> [u8; Velocity::LEN] {
     let mut buf = [0u8; Velocity::LEN];
     let mut direction = flags;
     // (Written out three times: each field's offset a constant, its bytes two stores.)
-    let mut put = |value: i32, at: usize, reverse_bit: u8| {
-        let (magnitude, reverse) = wire::split_signed(value, u16::MAX);
-        wire::put_u16(&mut buf, at, magnitude);
-        if reverse && magnitude != 0 {
-            direction |= reverse_bit;
-        }
-    };
-    put(x, field::X, dir::X_REVERSE);
-    put(y, field::Y, dir::Y_REVERSE);
-    put(z, field::Z, dir::Z_REVERSE);
+    put_signed(&mut buf, field::X, x, dir::X_REVERSE, &mut direction);
+    put_signed(&mut buf, field::Y, y, dir::Y_REVERSE, &mut direction);
+    put_signed(&mut buf, field::Z, z, dir::Z_REVERSE, &mut direction);
     wire::put(&mut buf, field::HEADER, &HEADER);
     wire::put_u8(&mut buf, field::MODE, mode::VELOCITY);
     wire::put_u8(&mut buf, field::VELOCITY_DIR, direction);
     buf
+}
+
+/// Writes `value`'s magnitude at `at` and sets `reverse_bit` in `direction` when it is
+/// negative and not zero. Inlined, so that each call's offset is a constant: two stores, not a
+/// loop the compiler would make a `memcpy` call.
+#[inline(always)]
+fn put_signed(buf: &mut [u8], at: usize, value: i32, reverse_bit: u8, direction: &mut u8) {
+    let (magnitude, reverse) = wire::split_signed(value, u16::MAX);
+    wire::put_u16(buf, at, magnitude);
+    if reverse && magnitude != 0 {
+        *direction |= reverse_bit;
+    }
 }
 
 /// Decodes a mode-`0x01` frame into signed X / Y / Z, the raw direction byte and the bits to
@@ -422,20 +427,13 @@ impl Motors {
         let mut buf = [0u8; Self::LEN];
         let mut direction = self.kept;
         // (Written out four times, as `encode_body` writes its three.)
-        let mut put = |value: i32, at: usize, reverse_bit: u8| {
-            let (magnitude, reverse) = wire::split_signed(value, u16::MAX);
-            wire::put_u16(&mut buf, at, magnitude);
-            if reverse && magnitude != 0 {
-                direction |= reverse_bit;
-            }
-        };
         let [v0, v1, v2, v3] = self.values;
         let [at0, at1, at2, at3] = field::MOTOR;
         let [r0, r1, r2, r3] = dir::MOTOR_REVERSE;
-        put(v0, at0, r0);
-        put(v1, at1, r1);
-        put(v2, at2, r2);
-        put(v3, at3, r3);
+        put_signed(&mut buf, at0, v0, r0, &mut direction);
+        put_signed(&mut buf, at1, v1, r1, &mut direction);
+        put_signed(&mut buf, at2, v2, r2, &mut direction);
+        put_signed(&mut buf, at3, v3, r3, &mut direction);
         wire::put(&mut buf, field::HEADER, &HEADER);
         wire::put_u8(&mut buf, field::MODE, self.control.mode());
         wire::put_u8(&mut buf, field::MOTORS_DIR, direction);
