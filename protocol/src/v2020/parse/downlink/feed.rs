@@ -3,7 +3,7 @@
 //! window until it needs more bytes.
 
 use super::judge::Verdict;
-use super::{DownlinkParser, RESUME_DRAIN, short_ways};
+use super::{DownlinkParser, RESUME_DRAIN, WINDOW, short_ways};
 use crate::telemetry::{Downlink, Kind};
 
 impl DownlinkParser {
@@ -201,6 +201,7 @@ impl DownlinkParser {
     /// between changes nothing).
     pub(super) fn expect_now(&mut self, code: Option<u8>) {
         self.expect = code;
+        self.header_at = 0;
         self.missing = self.missing.min(self.front_missing()).max(1);
     }
 
@@ -210,6 +211,10 @@ impl DownlinkParser {
             match self.judge(quiet) {
                 Verdict::NeedMore(n) => {
                     self.wait_for(n);
+                    return None;
+                }
+                Verdict::NeedHeader => {
+                    self.wait_for_header();
                     return None;
                 }
                 Verdict::Reject => self.reject(),
@@ -227,6 +232,7 @@ impl DownlinkParser {
     #[inline]
     pub(super) fn wait_for(&mut self, n: usize) {
         self.drain = false;
+        self.header_at = 0;
         // Only a wait of two bytes or more is worth the shortcut: with one, the next byte is
         // judged anyway (and a lone junk byte is dropped at once).
         self.missing = if n > 1 {
@@ -234,6 +240,31 @@ impl DownlinkParser {
         } else {
             0
         };
+    }
+
+    /// Nothing can be decided before the chain's next header, two bytes from the window's end
+    /// ([`Verdict::NeedHeader`]): they are only stored, then [`header_wait`](Self::header_wait)
+    /// looks at them.
+    pub(super) fn wait_for_header(&mut self) {
+        self.wait_for(2);
+        self.header_at = u8::try_from(self.buf.len()).unwrap_or(0);
+    }
+
+    /// After [`wait_for_header`](Self::wait_for_header), with those two bytes in: a header there
+    /// whose frame fits the window makes the judgement wait for the rest of that frame (the
+    /// chain's walk reaches it as it left it, nothing before it having changed, and its frame
+    /// is incomplete): how many more bytes. `None`: the judgement decides.
+    #[inline]
+    pub(super) fn header_wait(&self) -> Option<usize> {
+        let at = usize::from(self.header_at);
+        if at == 0 || !short_ways() {
+            return None;
+        }
+        let [first, second] = *self.buf.as_slice().get(at..)? else {
+            return None;
+        };
+        let len = Kind::from_header(first, second)?.len();
+        (at.checked_add(len)? <= WINDOW).then(|| len.saturating_sub(2))
     }
 
     /// Appends bytes; if the window is ever full, its first byte is rejected rather than a new

@@ -13,15 +13,28 @@ pub(super) enum Verdict {
     /// Not enough bytes to decide: at least this many more (1 or more) before a decision can
     /// fall (a quiet line aside).
     NeedMore(usize),
+    /// Not before the chain's next frame: two more bytes, its header, at the window's end. A
+    /// header there only makes the judgement wait for the rest of its frame, if it fits the
+    /// window ([`DownlinkParser::header_wait`]).
+    NeedHeader,
     /// The first byte starts no frame: drop it.
     Reject,
     /// A frame of this length, and what it was seen to be.
     Accept(Downlink, usize, Seen),
 }
 
-/// What a step of the walk decided: `Break` with the chain's answer (`Err(n)`: not before `n`
-/// more bytes), or `Continue`.
-type Step<T = ()> = ControlFlow<Result<bool, usize>, T>;
+/// Why a chain cannot decide yet.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Wait {
+    /// Not before this many more bytes.
+    Bytes(usize),
+    /// Not before the next frame's header, two bytes, right at the window's end.
+    Header,
+}
+
+/// What a step of the walk decided: `Break` with the chain's answer (`Err`: not yet), or
+/// `Continue`.
+type Step<T = ()> = ControlFlow<Result<bool, Wait>, T>;
 
 /// A walk along the frames right after a candidate, link by link, until one vouches for it
 /// (or proves it false, or more bytes are needed): what [`DownlinkParser::chain`] keeps from
@@ -110,13 +123,18 @@ impl<'a> Walk<'a> {
                 }
                 (None, _) if at == pos && quiet => return Break(Ok(self.rule.quiet)),
                 (Some(a), None) if Kind::may_start(*a) && !quiet => {
-                    return Break(undecided(buf, 1));
+                    return Break(undecided(buf, Wait::Bytes(1)));
                 }
                 // Nothing after the candidate yet: the next header is two bytes. Its first
                 // alone allows one decision (not a header: reject), and taking it a byte later,
                 // with the second, decides the same (a reply nobody awaits is judged once less).
                 (None, _) if !quiet => {
-                    return Break(undecided(buf, if at == pos { 2 } else { 1 }));
+                    let wait = if at == pos {
+                        Wait::Header
+                    } else {
+                        Wait::Bytes(1)
+                    };
+                    return Break(undecided(buf, wait));
                 }
                 _ => {}
             }
@@ -128,7 +146,7 @@ impl<'a> Walk<'a> {
     /// boundary, whose next frame lost its first byte: the frame after that one decides. Unless
     /// the reply's last byte is that first byte (`FF`): the next frame's header is then whole,
     /// a byte early, and it is the reply that lost a byte.
-    fn no_header(&self) -> Result<bool, usize> {
+    fn no_header(&self) -> Result<bool, Wait> {
         let (buf, pos) = (self.buf, self.pos);
         let [sync, _] = telemetry::Imu::HEADER;
         let lost_first = buf
@@ -161,7 +179,7 @@ impl<'a> Walk<'a> {
             return Break(if self.quiet || end > WINDOW {
                 Ok(false)
             } else {
-                Err(end.saturating_sub(buf.len()))
+                Err(Wait::Bytes(end.saturating_sub(buf.len())))
             });
         };
         let Some(next) = Downlink::read(kind, bytes) else {
@@ -397,7 +415,7 @@ impl DownlinkParser {
         len: usize,
         rule: Rule,
         quiet: bool,
-    ) -> Result<bool, usize> {
+    ) -> Result<bool, Wait> {
         let mut walk = Walk::new(self, buf, frame, len, rule, quiet);
         loop {
             let step = match walk.next_header() {
@@ -438,10 +456,10 @@ impl DownlinkParser {
         let taken = match rules::decide(self.start(), facts).1 {
             Need::Now => Ok(true),
             Need::Never => Ok(false),
-            Need::Follow => followed(buf, len, quiet).ok_or(1),
+            Need::Follow => followed(buf, len, quiet).ok_or(Wait::Bytes(1)),
             Need::Quiet => match buf.get(len..) {
                 Some([]) | None if quiet => Ok(true),
-                Some([]) | None => Err(1),
+                Some([]) | None => Err(Wait::Bytes(1)),
                 Some(_) => Ok(false),
             },
             Need::Chain(rule) => self.chain(buf, &frame, len, rule, quiet),
@@ -449,7 +467,8 @@ impl DownlinkParser {
         match taken {
             Ok(true) => Verdict::Accept(frame, len, facts.seen),
             Ok(false) => Verdict::Reject,
-            Err(more) => Verdict::NeedMore(more.max(1)),
+            Err(Wait::Bytes(more)) => Verdict::NeedMore(more.max(1)),
+            Err(Wait::Header) => Verdict::NeedHeader,
         }
     }
 
@@ -487,7 +506,7 @@ impl DownlinkParser {
         damaged: Stream,
         places: &[usize],
         quiet: bool,
-    ) -> Result<bool, usize> {
+    ) -> Result<bool, Wait> {
         if self.lock != Lock::Locked {
             return Ok(false);
         }
@@ -497,7 +516,10 @@ impl DownlinkParser {
             let next = match (buf.get(at), buf.get(at.saturating_add(1))) {
                 (Some(a), Some(b)) => Kind::from_header(*a, *b),
                 _ if quiet => return Ok(false),
-                _ => return undecided(buf, at.saturating_add(2).saturating_sub(buf.len())),
+                _ => {
+                    let more = at.saturating_add(2).saturating_sub(buf.len());
+                    return undecided(buf, Wait::Bytes(more));
+                }
             };
             let Some(Kind::Telemetry(stream)) = next else {
                 continue;
@@ -507,7 +529,7 @@ impl DownlinkParser {
                 return if quiet || end > WINDOW {
                     Ok(false)
                 } else {
-                    Err(end.saturating_sub(buf.len()))
+                    Err(Wait::Bytes(end.saturating_sub(buf.len())))
                 };
             };
             if counts.rel(stream, *seq, at) == Rel::Continues {
@@ -524,12 +546,12 @@ fn wide(delta: u8) -> bool {
     delta > FIRST_STEP_MAX
 }
 
-/// Not decided: `more` bytes are needed, unless the window is already full.
-fn undecided(buf: &[u8], more: usize) -> Result<bool, usize> {
+/// Not decided: `wait`, unless the window is already full.
+fn undecided(buf: &[u8], wait: Wait) -> Result<bool, Wait> {
     if buf.len() >= WINDOW {
         Ok(false)
     } else {
-        Err(more)
+        Err(wait)
     }
 }
 /// Whether a header (or the quiet line) follows the `len` bytes of the candidate.

@@ -154,6 +154,9 @@ pub struct DownlinkParser {
     missing: u8,
     /// The frame before the window was found while hunting (see [`rules::Start::Resynced`]).
     resynced: bool,
+    /// Where the last judgement waited for the chain's next header (the window's length then;
+    /// 0: it did not): see [`header_wait`](DownlinkParser::header_wait).
+    header_at: u8,
     /// What was thrown away right before the window.
     thrown: Thrown,
     stats: DownlinkStats,
@@ -232,6 +235,7 @@ impl DownlinkParser {
             since_frame: 0,
             missing: 0,
             resynced: false,
+            header_at: 0,
             thrown: Thrown::new(),
             stats: DownlinkStats::new(),
         }

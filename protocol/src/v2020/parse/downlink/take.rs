@@ -44,6 +44,9 @@ const _: () = assert!(matches!(
 pub(super) enum Row11 {
     /// Not before this many more bytes.
     Wait(usize),
+    /// Not before the next frame's header, two bytes right after the reply (as
+    /// [`Verdict::NeedHeader`](super::judge::Verdict::NeedHeader)).
+    Header,
     /// The reply at the front, `usize` bytes, is taken.
     Take(Downlink, usize),
     /// The general judgement decides.
@@ -91,6 +94,10 @@ impl DownlinkParser {
     /// shortcut, else the general judgement.
     #[inline(never)]
     fn complete_judged(&mut self) -> Option<Downlink> {
+        if let Some(more) = self.header_wait() {
+            self.wait_for(more);
+            return None;
+        }
         let bytes = self.buf.as_slice();
         if let [first, second, ..] = *bytes {
             if let Some(kind) = Kind::from_header(first, second) {
@@ -103,6 +110,10 @@ impl DownlinkParser {
                 match self.unawaited_reply(kind) {
                     Row11::Wait(more) => {
                         self.wait_for(more);
+                        return None;
+                    }
+                    Row11::Header => {
+                        self.wait_for_header();
                         return None;
                     }
                     Row11::Take(reply, len) => {
@@ -135,7 +146,7 @@ impl DownlinkParser {
         };
         let [first, second, ..] = *next else {
             return if next.is_empty() {
-                Row11::Wait(2)
+                Row11::Header
             } else {
                 Row11::Judge
             };
@@ -188,6 +199,7 @@ impl DownlinkParser {
         // is all the window holds, if the window holds anything.)
         let kind = Kind::Telemetry(stream);
         self.buf.clear();
+        self.header_at = 0;
         self.resynced = false;
         self.left(kind, kind.len());
         self.counts.take_step(stream, step, seq);
@@ -287,6 +299,7 @@ impl DownlinkParser {
         }
         let first = self.buf.as_slice().first().copied().unwrap_or(0);
         self.buf.drop_front(1);
+        self.header_at = 0;
         self.discard(first);
     }
 
@@ -391,6 +404,7 @@ impl DownlinkParser {
     #[inline]
     pub(super) fn leave(&mut self, kind: Kind, len: usize) {
         self.buf.drop_front(len);
+        self.header_at = 0;
         self.resynced = self.lock == Lock::Hunting;
         if self.lock == Lock::Hunting {
             self.stats.resyncs = self.stats.resyncs.wrapping_add(1);
