@@ -207,6 +207,7 @@ impl DownlinkParser {
 
     pub(super) fn run(&mut self, quiet: bool) -> Option<Downlink> {
         self.missing = 0;
+        self.header_at = 0;
         loop {
             match self.judge(quiet) {
                 Verdict::NeedMore(n) => {
@@ -232,7 +233,6 @@ impl DownlinkParser {
     #[inline]
     pub(super) fn wait_for(&mut self, n: usize) {
         self.drain = false;
-        self.header_at = 0;
         // Only a wait of two bytes or more is worth the shortcut: with one, the next byte is
         // judged anyway (and a lone junk byte is dropped at once).
         self.missing = if n > 1 {
@@ -250,13 +250,14 @@ impl DownlinkParser {
         self.header_at = u8::try_from(self.buf.len()).unwrap_or(0);
     }
 
-    /// After [`wait_for_header`](Self::wait_for_header), with those two bytes in: a header there
-    /// whose frame fits the window makes the judgement wait for the rest of that frame (the
-    /// chain's walk reaches it as it left it, nothing before it having changed, and its frame
-    /// is incomplete): how many more bytes. `None`: the judgement decides.
+    /// At the first judgement after [`wait_for_header`](Self::wait_for_header) (it applies to
+    /// that one only), with those two bytes in: a header there whose frame fits the window
+    /// makes the judgement wait for the rest of that frame (the chain's walk reaches it as it
+    /// left it, nothing before it having changed, and its frame is incomplete): how many more
+    /// bytes. `None`: the judgement decides.
     #[inline]
-    pub(super) fn header_wait(&self) -> Option<usize> {
-        let at = usize::from(self.header_at);
+    pub(super) fn header_wait(&mut self) -> Option<usize> {
+        let at = usize::from(core::mem::take(&mut self.header_at));
         if at == 0 || !short_ways() {
             return None;
         }

@@ -26,8 +26,8 @@ pub(super) enum Verdict {
 /// Why a chain cannot decide yet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Wait {
-    /// Not before this many more bytes.
-    Bytes(usize),
+    /// Not before this many more bytes (the window's length at most).
+    Bytes(u8),
     /// Not before the next frame's header, two bytes, right at the window's end.
     Header,
 }
@@ -179,7 +179,7 @@ impl<'a> Walk<'a> {
             return Break(if self.quiet || end > WINDOW {
                 Ok(false)
             } else {
-                Err(Wait::Bytes(end.saturating_sub(buf.len())))
+                Err(more(end, buf))
             });
         };
         let Some(next) = Downlink::read(kind, bytes) else {
@@ -467,7 +467,7 @@ impl DownlinkParser {
         match taken {
             Ok(true) => Verdict::Accept(frame, len, facts.seen),
             Ok(false) => Verdict::Reject,
-            Err(Wait::Bytes(more)) => Verdict::NeedMore(more.max(1)),
+            Err(Wait::Bytes(more)) => Verdict::NeedMore(usize::from(more.max(1))),
             Err(Wait::Header) => Verdict::NeedHeader,
         }
     }
@@ -517,8 +517,7 @@ impl DownlinkParser {
                 (Some(a), Some(b)) => Kind::from_header(*a, *b),
                 _ if quiet => return Ok(false),
                 _ => {
-                    let more = at.saturating_add(2).saturating_sub(buf.len());
-                    return undecided(buf, Wait::Bytes(more));
+                    return undecided(buf, more(at.saturating_add(2), buf));
                 }
             };
             let Some(Kind::Telemetry(stream)) = next else {
@@ -529,7 +528,7 @@ impl DownlinkParser {
                 return if quiet || end > WINDOW {
                     Ok(false)
                 } else {
-                    Err(Wait::Bytes(end.saturating_sub(buf.len())))
+                    Err(more(end, buf))
                 };
             };
             if counts.rel(stream, *seq, at) == Rel::Continues {
@@ -544,6 +543,11 @@ impl DownlinkParser {
 /// still a step on (any up to 255: a count stepping down by one steps by 255).
 fn wide(delta: u8) -> bool {
     delta > FIRST_STEP_MAX
+}
+
+/// Not before `end` bytes are in the window that holds `buf`.
+fn more(end: usize, buf: &[u8]) -> Wait {
+    Wait::Bytes(u8::try_from(end.saturating_sub(buf.len())).unwrap_or(u8::MAX))
 }
 
 /// Not decided: `wait`, unless the window is already full.

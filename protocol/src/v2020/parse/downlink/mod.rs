@@ -155,7 +155,8 @@ pub struct DownlinkParser {
     /// The frame before the window was found while hunting (see [`rules::Start::Resynced`]).
     resynced: bool,
     /// Where the last judgement waited for the chain's next header (the window's length then;
-    /// 0: it did not): see [`header_wait`](DownlinkParser::header_wait).
+    /// 0: it did not), until the next judgement: see
+    /// [`header_wait`](DownlinkParser::header_wait).
     header_at: u8,
     /// What was thrown away right before the window.
     thrown: Thrown,

@@ -199,7 +199,6 @@ impl DownlinkParser {
         // is all the window holds, if the window holds anything.)
         let kind = Kind::Telemetry(stream);
         self.buf.clear();
-        self.header_at = 0;
         self.resynced = false;
         self.left(kind, kind.len());
         self.counts.take_step(stream, step, seq);
@@ -401,10 +400,10 @@ impl DownlinkParser {
 impl DownlinkParser {
     /// A frame of `kind`, `len` bytes, was taken: its bytes leave the window, it is counted, and
     /// the parser is Locked right after it (the counts are the caller's).
-    #[inline]
+    // (Always inlined: out of line, its two callers cost more flash than its copies.)
+    #[inline(always)]
     pub(super) fn leave(&mut self, kind: Kind, len: usize) {
         self.buf.drop_front(len);
-        self.header_at = 0;
         self.resynced = self.lock == Lock::Hunting;
         if self.lock == Lock::Hunting {
             self.stats.resyncs = self.stats.resyncs.wrapping_add(1);
