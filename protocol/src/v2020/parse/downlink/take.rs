@@ -298,7 +298,6 @@ impl DownlinkParser {
         }
         let first = self.buf.as_slice().first().copied().unwrap_or(0);
         self.buf.drop_front(1);
-        self.header_at = 0;
         self.discard(first);
     }
 

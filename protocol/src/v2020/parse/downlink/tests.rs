@@ -109,6 +109,23 @@ fn a_reply_nobody_awaits_needs_the_next_count() {
     assert_eq!(out, vec![Downlink::Reply(reply), Downlink::Imu(imu(4, 0))]);
 }
 
+#[test]
+fn a_reply_awaited_from_between_the_next_headers_bytes_comes_out_at_once() {
+    // The reply waits for the next frame's header (row 11); the master asks for it between
+    // that header's two bytes: judged at the second as the awaited reply (row 2), not left
+    // waiting for the frame the header starts.
+    let mut p = locked();
+    let reply = Reply::new(Register::MaxSpeed, 500);
+    assert_eq!(feed(&mut p, &reply.encode()), vec![]);
+    let next = imu(4, 0).encode();
+    assert_eq!(p.push(next[0]), None);
+    p.expect_reply(Some(Register::MaxSpeed));
+    assert_eq!(p.push(next[1]), Some(Downlink::Reply(reply)));
+    let mut out = feed(&mut p, &next[2..]);
+    out.extend(p.poll());
+    assert_eq!(out, vec![Downlink::Imu(imu(4, 0))]);
+}
+
 /// A parser locked on IMU frames 1..=3 is sent a reply nobody awaits, then IMU 4 damaged by
 /// `damage`, then IMU 5 and 6: what comes out, the line then going quiet.
 fn reply_then_damaged_frame(damage: impl FnOnce(&mut Vec<u8>)) -> Vec<Downlink> {
