@@ -26,10 +26,11 @@ const ICOUNT_MACHINES: [IcountMachine; 2] = [
 ];
 
 /// What the 2020 parser may not grow past on the telemetry mix, in instructions per byte on the
-/// Cortex-M4 through `push`: a regression guard, a little above what it measures (39.2, with
-/// the window's bytes first in the parser, the counts word-aligned and no `memcpy` on its
-/// paths; 43.4 before). The goal (30, stretch 25) is not met.
-pub const ICOUNT_CEILING_M4: u64 = 41;
+/// Cortex-M4 through `push`: a regression guard, a little above what it measures (37.2, with
+/// the window's bytes first in the parser, the counts word-aligned, no `memcpy` on its paths,
+/// and a chain's next header only waited for; 43.4 before). The goal (30, stretch 25) is not
+/// met.
+pub const ICOUNT_CEILING_M4: u64 = 39;
 
 /// The 2020 parser's goal on the telemetry mix, in instructions per byte on the Cortex-M4.
 pub const ICOUNT_GOAL_M4: u64 = 30;
