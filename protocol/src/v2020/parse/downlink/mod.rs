@@ -128,32 +128,34 @@ pub enum Lock {
 #[derive(Clone, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 // (Laid out in this order, the window's bytes first: `push`'s fast path, inlined into the
-// caller's loop, then stores a byte at the parser's address plus `end`, with no offset to add.)
+// caller's loop, then stores a byte at the parser's address plus `end`, with no offset to add;
+// and `missing` right after the window's `end`, so that a Cortex-M0, whose loads reach 31
+// bytes from a register, reads both from one.)
 #[repr(C)]
 pub struct DownlinkParser {
     buf: Window<WINDOW>,
-    /// Bytes consumed since the last frame taken (saturating).
-    since_frame: u16,
-    counts: Counts,
-    lock: Lock,
-    /// The reply code awaited, if any.
-    expect: Option<u8>,
-    /// What [`expect_reply`](DownlinkParser::expect_reply) said while frames were still to
-    /// come out, and how many bytes were [`behind`](DownlinkParser::behind) then: it applies
-    /// once those frames and bytes are judged, as if they had all come out before the call.
-    expect_next: Option<(Option<u8>, u8)>,
-    /// The last call emitted a frame: another may be ready without a new byte.
-    drain: bool,
-    /// Bytes stored behind frames not yet out.
-    behind: Behind,
     /// Bytes to store before anything can be decided (0 or 1: none; always 0 while `drain`):
     /// the rest of the frame whose header is at the front of the window, once judging it has
     /// needed more; or, right after a frame taken by row 1 with the window empty, the next
     /// frame's two header bytes (the first is judged with the second). Until the last one, a
     /// byte is only stored.
     missing: u8,
+    lock: Lock,
+    /// Bytes consumed since the last frame taken (saturating).
+    since_frame: u16,
+    /// The last call emitted a frame: another may be ready without a new byte.
+    drain: bool,
     /// The frame before the window was found while hunting (see [`rules::Start::Resynced`]).
     resynced: bool,
+    counts: Counts,
+    /// The reply code awaited, if any.
+    expect: Option<u8>,
+    /// What [`expect_reply`](DownlinkParser::expect_reply) said while frames were still to
+    /// come out, and how many bytes were [`behind`](DownlinkParser::behind) then: it applies
+    /// once those frames and bytes are judged, as if they had all come out before the call.
+    expect_next: Option<(Option<u8>, u8)>,
+    /// Bytes stored behind frames not yet out.
+    behind: Behind,
     /// Where the last judgement waited for the chain's next header (the window's length then;
     /// 0: it did not), until the next judgement: see
     /// [`header_wait`](DownlinkParser::header_wait).
