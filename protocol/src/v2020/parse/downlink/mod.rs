@@ -129,8 +129,9 @@ pub enum Lock {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 // (Laid out in this order, the window's bytes first: `push`'s fast path, inlined into the
 // caller's loop, then stores a byte at the parser's address plus `end`, with no offset to add;
-// and `missing` right after the window's `end`, so that a Cortex-M0, whose loads reach 31
-// bytes from a register, reads both from one.)
+// then what a byte reads on its way (`missing`, the lock, `since_frame`, `drain`, `resynced`),
+// right after the window's `end`, so that a Cortex-M0, whose loads reach 31 bytes from a
+// register, reads them from one.)
 #[repr(C)]
 pub struct DownlinkParser {
     buf: Window<WINDOW>,
