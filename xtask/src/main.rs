@@ -7,7 +7,7 @@
 //! | `package` | the crates published to the registry packaged together, each built from its package alone; the protocol crate's file list and size (part of `test`) |
 //! | `public-api [--bless]` | the protocol crate's public API (every feature) against `protocol/public-api.txt`; `--bless` writes the snapshot (the check is part of `test`) |
 //! | `size` | flash and RAM of every board's firmware, and the protocol crate's share (size probes) |
-//! | `icount` | the downlink parsers' (2020 and v1.0.0) instructions per byte on the emulated Cortex-M4 and Cortex-M0; with `--profile`, where the 2020 parser's go on the Cortex-M4, by function and by byte |
+//! | `icount` | the downlink parsers' (2020 and v1.0.0) instructions per byte on the emulated Cortex-M4 and Cortex-M0; with `--profile`, where the 2020 parser's go on each core, by function and by byte, and its costliest bytes |
 //! | `fuzz [SECONDS]` | only the fuzz targets, each for SECONDS (default 30), exploring: random seed, corpora kept |
 //! | `sweep [--seed N] [--v1]` | the full noise sweep of the downlink parser over every stream model (a few minutes; not part of `test`), then the v1.0.0 board → master parser's (`--v1`: only that one, about 15 s) |
 //! | `bench [--runs N]` | the parser beside its peers (sbus-rs, uf-crsf, crsf) and the v1.0.0 parser in one run (or N: the median of each run's ratios): a table with the ratios (not part of `test`, which only builds it) |

@@ -8,13 +8,13 @@ use crate::tools::install_targets;
 use std::process::Command;
 
 /// One machine of the instruction-count run.
-struct IcountMachine {
-    target: &'static str,
-    qemu: &'static [&'static str],
+pub(super) struct IcountMachine {
+    pub(super) target: &'static str,
+    pub(super) qemu: &'static [&'static str],
 }
 
 /// The emulated cores: the Cortex-M4 (mps2-an386) and the Cortex-M0 (micro:bit).
-const ICOUNT_MACHINES: [IcountMachine; 2] = [
+pub(super) const ICOUNT_MACHINES: [IcountMachine; 2] = [
     IcountMachine {
         target: M4,
         qemu: &["-machine", "mps2-an386", "-cpu", "cortex-m4"],

@@ -1,16 +1,17 @@
 //! `cargo xtask icount --profile`: where the 2020 parser's instructions go on the Cortex-M4's
-//! telemetry mix, by function and by byte.
+//! and the Cortex-M0's telemetry mix, by function and by byte, and the costliest bytes.
 //!
 //! The instruction-count binary runs in QEMU with every translated block's instructions and
 //! every block executed logged (`-d in_asm,exec,nochain`). The run's SysTick reads
 //! (`time::cycles`) cut it into its measurements; the first one through the byte path
 //! (`icount::parse_all`) is the telemetry mix through `push`, the figure `cargo xtask icount`
-//! prints. Each block's instructions are charged to the function holding its first address
-//! (the ELF's symbols), and to the byte being fed: a byte starts where `parse_all`'s loop comes
-//! back to its head.
+//! prints, the second the random bytes. Each block's instructions are charged to the function
+//! holding its first address (the ELF's symbols), and to the byte being fed: a byte starts
+//! where `parse_all`'s loop comes back to its head.
 
+use super::icount::{ICOUNT_MACHINES, IcountMachine};
 use super::qemu::ensure_qemu;
-use super::{BOARDS, Board, M4, build_board, elf, firmware_target_dir};
+use super::{BOARDS, Board, M0, M4, build_board, elf, firmware_target_dir};
 use crate::tools::install_targets;
 use object::{Object, ObjectSymbol, SymbolKind};
 use std::collections::HashMap;
@@ -22,21 +23,35 @@ const CLOCK: &str = "cycles";
 
 /// `cargo xtask icount --profile`.
 pub fn profile() -> Result<(), String> {
-    install_targets(&[M4])?;
+    install_targets(&[M4, M0])?;
     ensure_qemu()?;
+    for machine in &ICOUNT_MACHINES {
+        profile_on(machine)?;
+    }
+    Ok(())
+}
+
+/// The profile on one emulated core.
+fn profile_on(machine: &IcountMachine) -> Result<(), String> {
     let board = Board {
-        target: M4,
+        target: machine.target,
         ..BOARDS[0]
     };
     build_board(
         &board,
-        &["--no-default-features", "--bin", "icount", "--target", M4],
+        &[
+            "--no-default-features",
+            "--bin",
+            "icount",
+            "--target",
+            machine.target,
+        ],
         &[("DEFMT_LOG", "off")],
     )?;
     let elf_path = elf(&board, "icount")?;
-    let log = firmware_target_dir()?.join("icount-profile.log");
+    let log = firmware_target_dir()?.join(format!("icount-profile-{}.log", machine.target));
     let status = Command::new("qemu-system-arm")
-        .args(["-machine", "mps2-an386", "-cpu", "cortex-m4"])
+        .args(machine.qemu)
         .args(["-display", "none", "-monitor", "none"])
         .args(["-semihosting-config", "enable=on,target=native"])
         .args(["-icount", "shift=0", "-d", "in_asm,exec,nochain", "-D"])
@@ -53,8 +68,31 @@ pub fn profile() -> Result<(), String> {
     let functions = Functions::read(&data)?;
     let text = std::fs::read_to_string(&log).map_err(|e| format!("{}: {e}", log.display()))?;
     let (sizes, trace) = blocks(&text);
-    let mix = mix_phase(&trace, &functions)?;
-    report(mix, &sizes, &functions);
+    let mut phases = byte_path_phases(&trace, &functions);
+    let (Some(mix), Some(random)) = (phases.next(), phases.next()) else {
+        return Err("no measurement through the byte path in the log".to_string());
+    };
+    let core = if machine.target == M4 {
+        "Cortex-M4"
+    } else {
+        "Cortex-M0"
+    };
+    println!(
+        "
+## {core}
+"
+    );
+    report(core, mix, &sizes, &functions);
+    let cost = |pc: &u64| sizes.get(pc).copied().unwrap_or(0);
+    let random = per_byte(random, &cost, &functions);
+    let total: u64 = random.iter().sum();
+    println!(
+        "
+random bytes through `push`: {} bytes, {:.1} instructions a byte; the costliest: {}",
+        random.len(),
+        total as f64 / random.len().max(1) as f64,
+        costliest(&random)
+    );
     Ok(())
 }
 
@@ -150,16 +188,19 @@ fn blocks(log: &str) -> (HashMap<u64, u64>, Vec<u64>) {
     (sizes, trace)
 }
 
-/// The blocks executed during the first measurement through the byte path.
-fn mix_phase<'t>(trace: &'t [u64], functions: &Functions) -> Result<&'t [u64], String> {
+/// The blocks executed during each measurement through the byte path, in order: the telemetry
+/// mix, then the random bytes.
+fn byte_path_phases<'t>(
+    trace: &'t [u64],
+    functions: &'t Functions,
+) -> impl Iterator<Item = &'t [u64]> + 't {
     trace
         .split(|pc| functions.is_in(*pc, CLOCK))
-        .find(|phase| phase.iter().any(|pc| functions.is_in(*pc, LOOP)))
-        .ok_or_else(|| "no measurement through the byte path in the log".to_string())
+        .filter(|phase| phase.iter().any(|pc| functions.is_in(*pc, LOOP)))
 }
 
 /// Prints the mix's instructions by function, then by byte.
-fn report(mix: &[u64], sizes: &HashMap<u64, u64>, functions: &Functions) {
+fn report(core: &str, mix: &[u64], sizes: &HashMap<u64, u64>, functions: &Functions) {
     let cost = |pc: &u64| sizes.get(pc).copied().unwrap_or(0);
     let total: u64 = mix.iter().map(cost).sum();
     let mut by_function: HashMap<&str, u64> = HashMap::new();
@@ -170,7 +211,7 @@ fn report(mix: &[u64], sizes: &HashMap<u64, u64>, functions: &Functions) {
     }
     let mut rows: Vec<_> = by_function.into_iter().collect();
     rows.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(b.0)));
-    println!("the telemetry mix through `push` on the Cortex-M4: {total} instructions\n");
+    println!("the telemetry mix through `push` on the {core}: {total} instructions\n");
     println!("| function | instructions | share |\n|---|---|---|");
     for (name, n) in rows.iter().take(16) {
         println!(
@@ -178,7 +219,21 @@ fn report(mix: &[u64], sizes: &HashMap<u64, u64>, functions: &Functions) {
             *n as f64 * 100.0 / total as f64
         );
     }
-    report_bytes(&per_byte(mix, &cost, functions));
+    let bytes = per_byte(mix, &cost, functions);
+    report_bytes(&bytes);
+    println!("\nthe costliest bytes of the mix: {}", costliest(&bytes));
+}
+
+/// The three costliest bytes: their instructions and where they are.
+fn costliest(bytes: &[u64]) -> String {
+    let mut order: Vec<usize> = (0..bytes.len()).collect();
+    order.sort_by_key(|i| std::cmp::Reverse(bytes[*i]));
+    order
+        .iter()
+        .take(3)
+        .map(|i| format!("{} instructions (byte {i})", bytes[*i]))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Each byte's instructions: a byte starts where the loop comes back to its head (its most
