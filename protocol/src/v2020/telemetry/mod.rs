@@ -248,7 +248,9 @@ impl Downlink {
     /// The frame of `kind` whose header starts `bytes` (the caller has checked it): a reply's
     /// bytes exactly; a telemetry frame's first, if all of it is there (bytes after it are left
     /// alone). The parser's way in: no second look at a telemetry header, its fields read
-    /// through fixed-size arrays.
+    /// through fixed-size arrays. (Out of line: inlined into the judgement, its decoders cost
+    /// flash twice.)
+    #[inline(never)]
     pub(crate) fn read(kind: Kind, bytes: &[u8]) -> Option<Downlink> {
         match kind {
             Kind::Telemetry(stream) => Downlink::read_telemetry(stream, bytes),

@@ -31,7 +31,7 @@ impl DownlinkParser {
             (_, Kind::Telemetry(stream), Some(seq)) => {
                 let rel = self.counts.rel(stream, seq, 0);
                 facts.seen = Seen::Telemetry(rel);
-                facts.cut = self.ends_with_a_header(frame, 0);
+                facts.cut = ends_with_a_header(self.buf.as_slice(), frame.kind(), 0);
                 if hunting {
                     facts.nested = self.nested(frame, rel);
                     facts.other_fits = matches!(rel, Rel::Continues | Rel::Near)
@@ -103,17 +103,6 @@ impl DownlinkParser {
     pub(super) fn is_the_rejected_frames_tail(&self, frame: &Downlink) -> bool {
         self.thrown.rejected == Some(frame.kind())
             && usize::from(self.thrown.rejected_left) == frame.kind().len()
-    }
-
-    /// Whether the last two bytes of the candidate `frame`, starting `at` bytes into the window,
-    /// are a telemetry header.
-    pub(super) fn ends_with_a_header(&self, frame: &Downlink, at: usize) -> bool {
-        let end = at.saturating_add(frame.kind().len());
-        self.buf
-            .as_slice()
-            .get(end.saturating_sub(2)..end)
-            .and_then(telemetry_header)
-            .is_some()
     }
 
     /// Whether the telemetry candidate `frame` at the front of the window ends with a frame of
@@ -254,6 +243,17 @@ impl DownlinkParser {
             lock => Start::from(lock),
         }
     }
+}
+
+/// Whether the last two bytes of a frame of `kind` starting `at` bytes into `window` are a
+/// telemetry header.
+#[inline(never)]
+pub(super) fn ends_with_a_header(window: &[u8], kind: Kind, at: usize) -> bool {
+    let end = at.saturating_add(kind.len());
+    window
+        .get(end.saturating_sub(2)..end)
+        .and_then(telemetry_header)
+        .is_some()
 }
 
 /// Whether `bytes` hold a telemetry header (a reply's value that might be a cut reply with the

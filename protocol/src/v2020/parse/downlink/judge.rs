@@ -1,7 +1,7 @@
 //! Judging the candidate at the front of the window: what the table ([`rules::decide`]) asks of
 //! it, and the chain of frames after it that may vouch for it ([`Walk`]).
 
-use super::class::stream_of_second;
+use super::class::{ends_with_a_header, stream_of_second};
 use super::counts::{Counts, FIRST_STEP_MAX, Rel};
 use super::rules::{self, Chain, Need, Seen, Walk as Rule};
 use super::{DownlinkParser, IN_STEP, Lock, WINDOW};
@@ -182,22 +182,31 @@ impl<'a> Walk<'a> {
                 Err(more(end, buf))
             });
         };
-        let Some(next) = Downlink::read(kind, bytes) else {
-            return Break(Ok(false));
+        // What the walk reads of a link: a telemetry frame's stream and count (its last byte;
+        // nothing else of it is read, so it is not decoded), or that it is a reply.
+        let telemetry = match kind {
+            Kind::Telemetry(stream) => match bytes.last() {
+                Some(&seq) => Some((stream, seq)),
+                None => return Break(Ok(false)),
+            },
+            Kind::Reply => {
+                let Some(Downlink::Reply(reply)) = Downlink::read(kind, bytes) else {
+                    return Break(Ok(false));
+                };
+                // The master asked once: an awaited reply whose chain holds another reply with
+                // the same code is not the answer (a `23` and the code in a damaged frame's
+                // tail, the real reply further on).
+                if self.rule.once && self.parser.expect == Some(reply.code) {
+                    return Break(Ok(false));
+                }
+                None
+            }
         };
-        // The master asked once: an awaited reply whose chain holds another reply with the same
-        // code is not the answer (a `23` and the code in a damaged frame's tail, the real reply
-        // further on).
-        if self.rule.once
-            && matches!(next, Downlink::Reply(reply) if self.parser.expect == Some(reply.code))
-        {
-            return Break(Ok(false));
-        }
         if self.rule.chain == Chain::Exact {
-            self.exact_link(&next, at, end)?;
+            self.exact_link(telemetry, at, end)?;
             self.skipped = true;
-        } else {
-            self.counted_link(&next, at)?;
+        } else if let Some((stream, seq)) = telemetry {
+            self.counted_link(stream, seq, at)?;
         }
         self.pos = end;
         self.gap = 0;
@@ -206,8 +215,8 @@ impl<'a> Walk<'a> {
 
     /// (Exact) Only the next frame, continuing exactly; a stream's first frame (no count to
     /// judge by) is passed over, a reply is not.
-    fn exact_link(&mut self, next: &Downlink, at: usize, end: usize) -> Step {
-        let (Kind::Telemetry(stream), Some(seq)) = (next.kind(), next.seq()) else {
+    fn exact_link(&mut self, telemetry: Option<(Stream, u8)>, at: usize, end: usize) -> Step {
+        let Some((stream, seq)) = telemetry else {
             return Break(Ok(false));
         };
         match self.counts.rel(stream, seq, at) {
@@ -236,10 +245,7 @@ impl<'a> Walk<'a> {
 
     /// (Verify, Rebase, Own, Restart) A link judged by its count: one that continues (or is
     /// near) its stream's vouches, if the chain lets its stream vouch.
-    fn counted_link(&mut self, next: &Downlink, at: usize) -> Step {
-        let (Kind::Telemetry(stream), Some(seq)) = (next.kind(), next.seq()) else {
-            return Continue(());
-        };
+    fn counted_link(&mut self, stream: Stream, seq: u8, at: usize) -> Step {
         if self.own == Some(stream) && self.counts.too_soon(stream, at) {
             return Break(Ok(false));
         }
@@ -250,7 +256,7 @@ impl<'a> Walk<'a> {
         // frame whose gyro Z reads -1 and whose count is `FA`..`FC` ends so; a cut frame's
         // `FA` must not be what the next lookalike's `FB` continues).
         let bit = 1u8 << stream.index();
-        if self.parser.ends_with_a_header(next, at) {
+        if ends_with_a_header(self.buf, Kind::Telemetry(stream), at) {
             if matches!(self.rule.chain, Chain::Verify | Chain::Rebase)
                 && self.passed.streams & bit == 0
                 && (self.own != Some(stream) || self.passed.own_linked)
