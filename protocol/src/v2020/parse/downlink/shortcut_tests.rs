@@ -350,6 +350,10 @@ fn a_header_wait_ends_at_the_judgement_a_quiet_line_makes() {
             Op::Quiet(1),
             Op::Bytes(after[..n].to_vec()),
         ];
-        assert_eq!(state_after(&ops, false), state_after(&ops, true), "{n} bytes after");
+        assert_eq!(
+            state_after(&ops, false),
+            state_after(&ops, true),
+            "{n} bytes after"
+        );
     }
 }
