@@ -15,6 +15,7 @@ use super::{BOARDS, Board, M0, M4, build_board, elf, firmware_target_dir};
 use crate::tools::install_targets;
 use object::{Object, ObjectSymbol, SymbolKind};
 use std::collections::HashMap;
+use std::path::Path;
 use std::process::Command;
 
 /// The parser's loop over the mix, and the clock read that starts and ends a measurement.
@@ -50,20 +51,7 @@ fn profile_on(machine: &IcountMachine) -> Result<(), String> {
     )?;
     let elf_path = elf(&board, "icount")?;
     let log = firmware_target_dir()?.join(format!("icount-profile-{}.log", machine.target));
-    let status = Command::new("qemu-system-arm")
-        .args(machine.qemu)
-        .args(["-display", "none", "-monitor", "none"])
-        .args(["-semihosting-config", "enable=on,target=native"])
-        .args(["-icount", "shift=0", "-d", "in_asm,exec,nochain", "-D"])
-        .arg(&log)
-        .arg("-kernel")
-        .arg(&elf_path)
-        .stdout(std::process::Stdio::null())
-        .status()
-        .map_err(|e| format!("could not start qemu-system-arm: {e}"))?;
-    if !status.success() {
-        return Err(format!("the profiled run failed ({status})"));
-    }
+    run_logged(machine, &elf_path, &log)?;
     let data = std::fs::read(&elf_path).map_err(|e| format!("{}: {e}", elf_path.display()))?;
     let functions = Functions::read(&data)?;
     let text = std::fs::read_to_string(&log).map_err(|e| format!("{}: {e}", log.display()))?;
@@ -94,6 +82,27 @@ random bytes through `push`: {} bytes, {:.1} instructions a byte; the costliest:
         costliest(&random)
     );
     Ok(())
+}
+
+/// Runs `elf` on `machine` in QEMU, every translated block and every block executed logged to
+/// `log`.
+fn run_logged(machine: &IcountMachine, elf: &Path, log: &Path) -> Result<(), String> {
+    let status = Command::new("qemu-system-arm")
+        .args(machine.qemu)
+        .args(["-display", "none", "-monitor", "none"])
+        .args(["-semihosting-config", "enable=on,target=native"])
+        .args(["-icount", "shift=0", "-d", "in_asm,exec,nochain", "-D"])
+        .arg(log)
+        .arg("-kernel")
+        .arg(elf)
+        .stdout(std::process::Stdio::null())
+        .status()
+        .map_err(|e| format!("could not start qemu-system-arm: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("the profiled run failed ({status})"))
+    }
 }
 
 /// The firmware's functions: (start, end, name), sorted.

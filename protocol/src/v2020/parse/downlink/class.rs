@@ -24,7 +24,7 @@ impl DownlinkParser {
             (Downlink::Reply(reply), ..) => {
                 facts.shadow = hunting && (self.in_shadow() || self.may_be_a_frames_tail());
                 facts.seen = Seen::Reply {
-                    awaited: self.expect == Some(reply.code),
+                    awaited: self.expect.code == Some(reply.code),
                     clean: !holds_a_frame_start(reply.encode().get(2..).unwrap_or(&[])),
                 };
             }

@@ -150,7 +150,7 @@ impl DownlinkParser {
                 break None;
             }
             let taken = behind.wrapping_sub(left);
-            if self.expect_next.is_some_and(|(_, at)| at == taken) {
+            if self.expect.next.is_some_and(|(_, at)| at == taken) {
                 self.expect_pending();
             }
             self.buf.unhide(at, 1);
@@ -162,7 +162,7 @@ impl DownlinkParser {
             }
         };
         self.buf.unhide(at, left);
-        if let Some((_, at)) = &mut self.expect_next {
+        if let Some((_, at)) = &mut self.expect.next {
             *at = at.saturating_sub(behind.wrapping_sub(left));
         }
         self.behind.len = left;
@@ -190,7 +190,7 @@ impl DownlinkParser {
     /// What [`expect_reply`](Self::expect_reply) said while frames were still to come out, now
     /// that they are out.
     fn expect_pending(&mut self) {
-        if let Some((code, _)) = self.expect_next.take() {
+        if let Some((code, _)) = self.expect.next.take() {
             self.expect_now(code);
         }
     }
@@ -200,7 +200,7 @@ impl DownlinkParser {
     /// was waiting for are in (and not at a `poll` before it: whether the caller polls in
     /// between changes nothing).
     pub(super) fn expect_now(&mut self, code: Option<u8>) {
-        self.expect = code;
+        self.expect.code = code;
         self.header_at = 0;
         self.missing = self.missing.min(self.front_missing()).max(1);
     }

@@ -196,7 +196,7 @@ impl<'a> Walk<'a> {
                 // The master asked once: an awaited reply whose chain holds another reply with
                 // the same code is not the answer (a `23` and the code in a damaged frame's
                 // tail, the real reply further on).
-                if self.rule.once && self.parser.expect == Some(reply.code) {
+                if self.rule.once && self.parser.expect.code == Some(reply.code) {
                     return Break(Ok(false));
                 }
                 None

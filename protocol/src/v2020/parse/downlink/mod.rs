@@ -149,12 +149,8 @@ pub struct DownlinkParser {
     /// The frame before the window was found while hunting (see [`rules::Start::Resynced`]).
     resynced: bool,
     counts: Counts,
-    /// The reply code awaited, if any.
-    expect: Option<u8>,
-    /// What [`expect_reply`](DownlinkParser::expect_reply) said while frames were still to
-    /// come out, and how many bytes were [`behind`](DownlinkParser::behind) then: it applies
-    /// once those frames and bytes are judged, as if they had all come out before the call.
-    expect_next: Option<(Option<u8>, u8)>,
+    /// The reply awaited.
+    expect: Expect,
     /// Bytes stored behind frames not yet out.
     behind: Behind,
     /// Where the last judgement waited for the chain's next header (the window's length then;
@@ -164,6 +160,18 @@ pub struct DownlinkParser {
     /// What was thrown away right before the window.
     thrown: Thrown,
     stats: DownlinkStats,
+}
+
+/// The reply the master awaits ([`DownlinkParser::expect_reply`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Expect {
+    /// Its code, if any.
+    code: Option<u8>,
+    /// What [`expect_reply`](DownlinkParser::expect_reply) said while frames were still to
+    /// come out, and how many bytes were [`behind`](DownlinkParser::behind) then: it applies
+    /// once those frames and bytes are judged, as if they had all come out before the call.
+    next: Option<(Option<u8>, u8)>,
 }
 
 /// Bytes stored at the window's end while `drain` (after a frame came out, before the next
@@ -232,8 +240,10 @@ impl DownlinkParser {
             buf: Window::new(),
             counts: Counts::new(),
             lock: Lock::Hunting,
-            expect: None,
-            expect_next: None,
+            expect: Expect {
+                code: None,
+                next: None,
+            },
             drain: false,
             behind: Behind { len: 0, resume: 0 },
             since_frame: 0,
@@ -399,9 +409,9 @@ impl DownlinkParser {
         let code = register.map(Register::reply_code);
         if self.drain {
             // Frames still to come out were decided without it.
-            self.expect_next = Some((code, self.behind.len));
+            self.expect.next = Some((code, self.behind.len));
         } else {
-            self.expect_next = None;
+            self.expect.next = None;
             self.expect_now(code);
         }
     }

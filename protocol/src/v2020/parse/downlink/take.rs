@@ -137,7 +137,9 @@ impl DownlinkParser {
     pub(super) fn unawaited_reply(&self, kind: Kind) -> Row11 {
         let bytes = self.buf.as_slice();
         let len = kind.len();
-        if kind != Kind::Reply || self.lock == Lock::Hunting || self.expect == bytes.get(1).copied()
+        if kind != Kind::Reply
+            || self.lock == Lock::Hunting
+            || self.expect.code == bytes.get(1).copied()
         {
             return Row11::Judge;
         }
@@ -388,8 +390,8 @@ impl DownlinkParser {
                 }
             }
             (Kind::Telemetry(stream), Some(seq), _) => self.counts.take(stream, seq, true),
-            (_, _, Downlink::Reply(reply)) if self.expect == Some(reply.code) => {
-                self.expect = None;
+            (_, _, Downlink::Reply(reply)) if self.expect.code == Some(reply.code) => {
+                self.expect.code = None;
             }
             _ => {}
         }
