@@ -243,7 +243,7 @@ impl DownlinkParser {
     }
 
     /// Nothing can be decided before the chain's next header, two bytes from the window's end
-    /// ([`Verdict::NeedHeader`]): they are only stored, then [`header_wait`](Self::header_wait)
+    /// ([`Verdict::NeedHeader`]): they are only stored, then [`chain_header_wait`](Self::chain_header_wait)
     /// looks at them.
     pub(super) fn wait_for_header(&mut self) {
         self.wait_for(2);
@@ -256,7 +256,7 @@ impl DownlinkParser {
     /// left it, nothing before it having changed, and its frame is incomplete): how many more
     /// bytes. `None`: the judgement decides.
     #[inline]
-    pub(super) fn header_wait(&mut self) -> Option<usize> {
+    pub(super) fn chain_header_wait(&mut self) -> Option<usize> {
         let at = usize::from(core::mem::take(&mut self.header_at));
         if at == 0 || !short_ways() {
             return None;

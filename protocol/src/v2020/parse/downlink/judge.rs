@@ -15,7 +15,7 @@ pub(super) enum Verdict {
     NeedMore(usize),
     /// Not before the chain's next frame: two more bytes, its header, at the window's end. A
     /// header there only makes the judgement wait for the rest of its frame, if it fits the
-    /// window ([`DownlinkParser::header_wait`]).
+    /// window ([`DownlinkParser::chain_header_wait`]).
     NeedHeader,
     /// The first byte starts no frame: drop it.
     Reject,

@@ -155,7 +155,7 @@ pub struct DownlinkParser {
     behind: Behind,
     /// Where the last judgement waited for the chain's next header (the window's length then;
     /// 0: it did not), until the next judgement: see
-    /// [`header_wait`](DownlinkParser::header_wait).
+    /// [`chain_header_wait`](DownlinkParser::chain_header_wait).
     header_at: u8,
     /// What was thrown away right before the window.
     thrown: Thrown,

@@ -94,7 +94,7 @@ impl DownlinkParser {
     /// shortcut, else the general judgement.
     #[inline(never)]
     fn complete_judged(&mut self) -> Option<Downlink> {
-        if let Some(more) = self.header_wait() {
+        if let Some(more) = self.chain_header_wait() {
             self.wait_for(more);
             return None;
         }
