@@ -2663,13 +2663,12 @@ fn v2020_a_replys_value_starting_like_a_header_makes_no_false_frame() {
 }
 
 #[test]
-#[ignore = "found by the outside attack: a cold start on payloads of header bytes only, under one shared counter, emits two frames the board never sent"]
 fn v2020_a_cold_start_on_header_byte_payloads_makes_no_false_frame() {
-    // README: "0 false frames on clean streams from any start" holds on payloads at rest; on
-    // payloads made only of header bytes (every field -6..-4, the sweep's adversarial model),
-    // one counter shared by IMU and encoder frames, +1 a frame, listening from the line's
-    // second byte: IMU { accel [-4, -4, -5], gyro [-4, -1793, -1025], seq 250 } and an encoder
-    // frame with count 252 come out, neither sent.
+    // README: "0 false frames on clean streams from any start". On payloads made only of header
+    // bytes (every field -6..-4, the sweep's adversarial model), one counter shared by IMU and
+    // encoder frames, +1 a frame, listening from the line's second byte, IMU { accel [-4, -4,
+    // -5], gyro [-4, -1793, -1025], seq 250 } and two encoder frames (counts 252 and 250) came
+    // out, none sent: the chain that vouched for the first held the other two back to back.
     let imu = |accel: [i16; 3], gyro: [i16; 3], seq: u8| Downlink::Imu(Imu { accel, gyro, seq });
     let sent = vec![
         imu([-5, -6, -5], [-6, -4, -4], 247),

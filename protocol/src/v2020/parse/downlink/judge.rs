@@ -63,7 +63,14 @@ struct Walk<'a> {
     skipped: bool,
     /// What the frames passed over (their count a header's second byte) left.
     passed: Passed,
+    /// Where the chain's last frame of each stream starts, the candidate's included
+    /// ([`NOT_YET`]: none), for [`Counts::too_soon`].
+    starts: [u8; 3],
 }
+
+/// [`Walk::starts`] for a stream with no frame in the chain yet (no window is this long).
+const NOT_YET: u8 = u8::MAX;
+const _: () = assert!(WINDOW < NOT_YET as usize);
 
 /// What the frames a chain passed over left, for a later one to vouch only from a count that
 /// neither they nor the candidate gave.
@@ -87,9 +94,13 @@ impl<'a> Walk<'a> {
         quiet: bool,
     ) -> Self {
         let mut counts = parser.counts;
+        let mut starts = [NOT_YET; 3];
         let own = match (frame.kind(), frame.seq()) {
             (Kind::Telemetry(stream), Some(seq)) => {
                 counts.take(stream, seq, false);
+                if let Some(start) = starts.get_mut(stream.index()) {
+                    *start = 0;
+                }
                 Some(stream)
             }
             _ => None,
@@ -107,6 +118,7 @@ impl<'a> Walk<'a> {
             shared: frame.seq().map(|seq| (seq, 0, 0)),
             skipped: false,
             passed: Passed::default(),
+            starts,
         }
     }
 
@@ -246,8 +258,14 @@ impl<'a> Walk<'a> {
     /// (Verify, Rebase, Own, Restart) A link judged by its count: one that continues (or is
     /// near) its stream's vouches, if the chain lets its stream vouch.
     fn counted_link(&mut self, stream: Stream, seq: u8, at: usize) -> Step {
-        if self.own == Some(stream) && self.counts.too_soon(stream, at) {
-            return Break(Ok(false));
+        // Two frames of a stream closer than the board's rates allow (lookalikes in a payload
+        // come back to back): the chain's alignment cannot be the board's.
+        // (`at` is less than the window's length, and after the stream's frame before.)
+        if let Some(start) = self.starts.get_mut(stream.index()) {
+            let before = core::mem::replace(start, at as u8);
+            if before != NOT_YET && self.counts.too_soon(stream, at.wrapping_sub(before.into())) {
+                return Break(Ok(false));
+            }
         }
         // A frame whose count byte is the second byte of a telemetry header (its last two
         // bytes are one: a cut frame running into the next one, row 15) is no evidence: passed

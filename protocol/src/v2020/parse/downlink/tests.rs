@@ -859,6 +859,43 @@ fn chain_a_frame_of_the_candidates_stream_sooner_than_its_rate_does_not_vouch() 
     }
 }
 
+/// The chain: two of its frames of one stream closer than the board's rates allow fail it,
+/// whatever their stream. Payloads made only of header bytes (every field -6..-4), one counter
+/// shared by IMU and encoder frames, +1 a frame, listening from the line's second byte: an IMU
+/// lookalike from IMU 248's tail into encoder frame 249 (its count the encoder's `FA`), then two
+/// encoder lookalikes back to back (counts 252 and 250, the second IMU 250's tail), then IMU
+/// 251 to 253, in step from the lookalike's 250. Before, the real IMU frames vouched for the
+/// lookalike and all three lookalikes came out.
+#[test]
+fn chain_two_frames_of_one_stream_sooner_than_its_rate_fail_it() {
+    let imu = |accel: [i16; 3], gyro: [i16; 3], seq: u8| Downlink::Imu(Imu { accel, gyro, seq });
+    let sent = [
+        imu([-5, -6, -5], [-6, -4, -4], 247),
+        imu([-5, -6, -4], [-4, -5, -4], 248),
+        Downlink::Encoders(Encoders {
+            ticks: [-6, -5, -4, -4],
+            seq: 249,
+        }),
+        imu([-4, -5, -5], [-6, -4, -4], 250),
+        imu([-6, -6, -5], [-5, -5, -4], 251),
+        imu([-4, -5, -6], [-5, -4, -6], 252),
+        imu([-6, -6, -4], [-4, -4, -4], 253),
+    ];
+    let line: Vec<u8> = sent
+        .iter()
+        .flat_map(|f| f.encode().as_ref().to_vec())
+        .collect();
+    let mut p = DownlinkParser::new();
+    let mut out = feed(&mut p, line.get(1..).unwrap_or(&[]));
+    out.extend(drain_quiet(&mut p, 5));
+    let false_frames: Vec<&Downlink> = out.iter().filter(|f| !sent.contains(f)).collect();
+    assert!(false_frames.is_empty(), "{false_frames:?}");
+    // The frames from IMU 251 on come out (the chain's own stream in step vouches for them).
+    for frame in sent.get(4..).unwrap_or(&[]) {
+        assert!(out.contains(frame), "{frame:?} lost: {out:?}");
+    }
+}
+
 /// Row 8 and the quiet line. The board sends an encoder frame and an IMU frame in one burst;
 /// the encoder frame loses a byte (the IMU frame's first byte is read as its count: rejected
 /// on its boundary), and the IMU frame, found while hunting, is the last before the line goes
