@@ -39,6 +39,9 @@ pub enum Payload {
     /// Every payload byte (values and counts aside) drawn from `FF FA FB FC 23` and the reply
     /// codes: lookalike headers and `#`s everywhere, far denser than [`Adversarial`](Self::Adversarial).
     Headers,
+    /// Every telemetry value reads -6..-4 (`FF FA`..`FF FC`): a telemetry header at every
+    /// other byte of every payload, and a count byte (`FA`..`FC`) at every byte after one.
+    Lookalikes,
 }
 
 /// What the count byte counts (A10: the vendor does not say).
@@ -245,6 +248,29 @@ impl BoardStream {
         }
     }
 
+    /// A telemetry frame whose values all read -6..-4 ([`Payload::Lookalikes`]); a reply as
+    /// it is.
+    fn lookalikes_frame(&mut self, frame: Downlink) -> Downlink {
+        let mut value = || self.rng.random_range(-6..=-4i16);
+        match frame {
+            Downlink::Imu(imu) => Downlink::Imu(Imu {
+                accel: [value(), value(), value()],
+                gyro: [value(), value(), value()],
+                seq: imu.seq,
+            }),
+            Downlink::Encoders(encoders) => Downlink::Encoders(Encoders {
+                ticks: [value(), value(), value(), value()],
+                seq: encoders.seq,
+            }),
+            Downlink::Battery(battery) => Downlink::Battery(Battery {
+                centivolts: value() as u16,
+                percent: value() as u16,
+                seq: battery.seq,
+            }),
+            reply @ Downlink::Reply(_) => reply,
+        }
+    }
+
     fn next_seq(&mut self, stream: usize) -> u8 {
         match self.counts {
             CountModel::PerStream(steps) => {
@@ -352,10 +378,10 @@ impl BoardStream {
             self.replies.sent(&mut self.rng);
             self.reply()
         };
-        let frame = if self.payload == Payload::Headers {
-            self.headers_frame(frame)
-        } else {
-            frame
+        let frame = match self.payload {
+            Payload::Headers => self.headers_frame(frame),
+            Payload::Lookalikes => self.lookalikes_frame(frame),
+            _ => frame,
         };
         // 86.8 us per byte at 115 200 bps, 8N1.
         self.now_us += frame.encode().len() as u64 * 1_000_000 / 11_520;

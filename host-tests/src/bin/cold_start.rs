@@ -3,7 +3,9 @@
 //! offset 0..200 of a clean stream of `--frames` frames (payloads at rest), fed one byte at a
 //! time, in random slices of 1..64 bytes or in 62-byte USB packets, with the line's quiet
 //! stretches after the start reported or not. Every frame that starts at or after the start
-//! counts, the first whole one too.
+//! counts, the first whole one too. Then the same, one byte at a time, on payloads written to
+//! fool a parser (the sweep's adversarial payloads, payloads of header bytes only, and payloads
+//! whose every value reads -6..-4: a header at every other byte).
 //!
 //! ```text
 //! cargo run --release -p chassis-host-tests --bin cold-start -- [--frames N] [--seed S]
@@ -50,6 +52,7 @@ fn main() -> ExitCode {
         println!("| {name} | {missed} | {false_frames} |");
     }
     every_step(&args);
+    hostile_payloads(&args);
     ExitCode::SUCCESS
 }
 
@@ -111,5 +114,39 @@ fn every_step(args: &Args) {
             })
             .collect();
         println!("| +{step} | {} |", cells.join(" | "));
+    }
+}
+
+/// Every count model on payloads written to fool a parser, one byte at a time: the worst
+/// start's misses and the false frames, the quiet line reported or not.
+fn hostile_payloads(args: &Args) {
+    println!(
+        "\nPayloads written to fool a parser (1-byte chunks; worst start: frames missed; false frames):\n"
+    );
+    println!(
+        "| payload | count model | no quiet: worst missed | no quiet: false | quiet reported: worst missed | quiet reported: false |"
+    );
+    println!("|---|---|---|---|---|---|");
+    for (payload_name, payload) in [
+        ("adversarial", Payload::Adversarial),
+        ("header bytes only", Payload::Headers),
+        ("every value -6..-4", Payload::Lookalikes),
+    ] {
+        for (name, counts) in count_models(args.seed) {
+            let model = Model {
+                seed: args.seed,
+                payload,
+                counts,
+                frames: args.frames,
+            };
+            let cells: Vec<String> = [false, true]
+                .into_iter()
+                .map(|quiet| {
+                    let c = cold_start(model, OFFSETS, quiet, Chunking::Bytes);
+                    format!("{} of {} | {}", c.worst.0, args.frames, c.false_frames)
+                })
+                .collect();
+            println!("| {payload_name} | {name} | {} |", cells.join(" | "));
+        }
     }
 }
