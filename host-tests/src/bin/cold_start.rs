@@ -5,7 +5,9 @@
 //! stretches after the start reported or not. Every frame that starts at or after the start
 //! counts, the first whole one too. Then the same, one byte at a time, on payloads written to
 //! fool a parser (the sweep's adversarial payloads, payloads of header bytes only, and payloads
-//! whose every value reads -6..-4: a header at every other byte).
+//! whose every value reads -6..-4: a header at every other byte); and the last of these over
+//! [`STREAMS`] short streams under shared counters, whose counts pass `FA`..`FC` (-6..-4's
+//! second byte) at some starts.
 //!
 //! ```text
 //! cargo run --release -p chassis-host-tests --bin cold-start -- [--frames N] [--seed S]
@@ -16,6 +18,9 @@ use chassis_host_tests::models::count_models;
 use chassis_host_tests::sweep::Args;
 use chassis_host_tests::{CountModel, Payload};
 use std::process::ExitCode;
+
+/// Streams (seeds from the one given on) of [`lookalike_streams`].
+const STREAMS: u64 = 400;
 
 /// Start offsets tried in each stream.
 const OFFSETS: std::ops::Range<usize> = 0..200;
@@ -53,6 +58,7 @@ fn main() -> ExitCode {
     }
     every_step(&args);
     hostile_payloads(&args);
+    lookalike_streams(&args);
     ExitCode::SUCCESS
 }
 
@@ -147,6 +153,47 @@ fn hostile_payloads(args: &Args) {
                 })
                 .collect();
             println!("| {payload_name} | {name} | {} |", cells.join(" | "));
+        }
+    }
+}
+
+/// Payloads whose every value reads -6..-4 under shared counters (+1, +2, +3 a frame), over
+/// [`STREAMS`] streams of 60 frames, every start 0..200, one byte at a time: a shared counter
+/// starts anywhere, so in some streams its counts pass `FA`..`FC`, the second bytes of the
+/// headers every payload is made of, and the count byte tells a frame from a lookalike no more.
+fn lookalike_streams(args: &Args) {
+    println!(
+        "\nEvery value -6..-4, {STREAMS} streams of 60 frames (seeds {} on), every start 0..200, 1-byte chunks:\n",
+        args.seed
+    );
+    println!(
+        "| count model | quiet reported | streams with a false frame | starts with a false frame | false frames |"
+    );
+    println!("|---|---|---|---|---|");
+    for (name, counts) in [
+        ("one shared counter", CountModel::Shared),
+        ("one shared counter +2", CountModel::SharedStep(2)),
+        ("one shared counter +3", CountModel::SharedStep(3)),
+    ] {
+        for quiet in [false, true] {
+            let (mut streams, mut starts, mut false_frames) = (0, 0, 0);
+            for k in 0..STREAMS {
+                let model = Model {
+                    seed: args.seed.wrapping_add(k),
+                    payload: Payload::Lookalikes,
+                    counts,
+                    frames: 60,
+                };
+                let c = cold_start(model, OFFSETS, quiet, Chunking::Bytes);
+                streams += usize::from(c.false_frames > 0);
+                starts += c.starts_false;
+                false_frames += c.false_frames;
+            }
+            println!(
+                "| {name} | {} | {streams} of {STREAMS} | {starts} of {} | {false_frames} |",
+                if quiet { "yes" } else { "no" },
+                STREAMS as usize * OFFSETS.len()
+            );
         }
     }
 }
