@@ -139,6 +139,37 @@ fn a_cold_start_misses_no_more_frames_than_today_and_emits_none_false() {
 }
 
 #[test]
+fn a_cold_start_on_payloads_written_to_fool_it_emits_no_false_frame() {
+    // One byte at a time, every start 0..200 of 300 frames, the quiet line reported or not: the
+    // sweep's adversarial payloads, payloads of header bytes only, and payloads whose every
+    // value reads -6..-4 (under a shared counter whose counts pass `FA`..`FC` the last still
+    // makes some at a few starts: `cold-start`'s last table, docs/parser.md). Frames missed at
+    // the worst start today: 1 under counts per stream or a tick, 2 to 4 under a shared counter
+    // (the quiet reported: 2).
+    for payload in [Payload::Adversarial, Payload::Headers, Payload::Lookalikes] {
+        for (name, counts) in count_models() {
+            let shared = matches!(counts, CountModel::Shared | CountModel::SharedStep(_));
+            for quiet in [false, true] {
+                let model = Model {
+                    seed: SEED,
+                    payload,
+                    counts,
+                    frames: 300,
+                };
+                let c = cold_start(model, 0..200, quiet, Chunking::Bytes);
+                assert_eq!(c.false_frames, 0, "{payload:?}, {name}, quiet {quiet}");
+                let ceiling = if shared && !quiet { 4 } else { 2 };
+                assert!(
+                    c.worst.0 <= ceiling,
+                    "{payload:?}, {name}, quiet {quiet}: {} missed",
+                    c.worst.0
+                );
+            }
+        }
+    }
+}
+
+#[test]
 #[ignore = "the parser misses 1 or 2 frames at some cold starts under every count model: the first whole frame, or a first burst that the quiet line ends, before any count has been seen to continue (a frame of a stream not yet seen, or a reply nobody awaits, found while hunting, can be any payload's tail)"]
 fn a_cold_start_is_exact_from_the_first_whole_frame_under_every_shared_counter() {
     for step in 1..=7 {
