@@ -222,22 +222,7 @@ impl BoardStream {
 
     /// A telemetry frame or reply whose payload is header bytes only ([`Payload::Headers`]).
     fn headers_frame(&mut self, frame: Downlink) -> Downlink {
-        let mut word = || self.header_word() as i16;
         match frame {
-            Downlink::Imu(imu) => Downlink::Imu(Imu {
-                accel: [word(), word(), word()],
-                gyro: [word(), word(), word()],
-                seq: imu.seq,
-            }),
-            Downlink::Encoders(encoders) => Downlink::Encoders(Encoders {
-                ticks: [word(), word(), word(), word()],
-                seq: encoders.seq,
-            }),
-            Downlink::Battery(battery) => Downlink::Battery(Battery {
-                centivolts: word() as u16,
-                percent: word() as u16,
-                seq: battery.seq,
-            }),
             Downlink::Reply(reply) => {
                 let value = (u32::from(self.header_word()) << 16) | u32::from(self.header_word());
                 Downlink::Reply(Reply {
@@ -245,30 +230,14 @@ impl BoardStream {
                     value,
                 })
             }
+            telemetry => with_values(telemetry, || self.header_word() as i16),
         }
     }
 
     /// A telemetry frame whose values all read -6..-4 ([`Payload::Lookalikes`]); a reply as
     /// it is.
     fn lookalikes_frame(&mut self, frame: Downlink) -> Downlink {
-        let mut value = || self.rng.random_range(-6..=-4i16);
-        match frame {
-            Downlink::Imu(imu) => Downlink::Imu(Imu {
-                accel: [value(), value(), value()],
-                gyro: [value(), value(), value()],
-                seq: imu.seq,
-            }),
-            Downlink::Encoders(encoders) => Downlink::Encoders(Encoders {
-                ticks: [value(), value(), value(), value()],
-                seq: encoders.seq,
-            }),
-            Downlink::Battery(battery) => Downlink::Battery(Battery {
-                centivolts: value() as u16,
-                percent: value() as u16,
-                seq: battery.seq,
-            }),
-            reply @ Downlink::Reply(_) => reply,
-        }
+        with_values(frame, || self.rng.random_range(-6..=-4i16))
     }
 
     fn next_seq(&mut self, stream: usize) -> u8 {
@@ -504,6 +473,28 @@ pub fn simulator_bursts(seed: u64, count: usize) -> (Vec<u8>, Vec<SentFrame>, Ve
     bytes.truncate(at);
     burst_ends.retain(|end| *end <= at);
     (bytes, frames, burst_ends)
+}
+
+/// A telemetry frame with every value drawn from `value`, in the order of the fields (its count
+/// kept); a reply as it is.
+fn with_values(frame: Downlink, mut value: impl FnMut() -> i16) -> Downlink {
+    match frame {
+        Downlink::Imu(imu) => Downlink::Imu(Imu {
+            accel: [value(), value(), value()],
+            gyro: [value(), value(), value()],
+            seq: imu.seq,
+        }),
+        Downlink::Encoders(encoders) => Downlink::Encoders(Encoders {
+            ticks: [value(), value(), value(), value()],
+            seq: encoders.seq,
+        }),
+        Downlink::Battery(battery) => Downlink::Battery(Battery {
+            centivolts: value() as u16,
+            percent: value() as u16,
+            seq: battery.seq,
+        }),
+        reply @ Downlink::Reply(_) => reply,
+    }
 }
 
 #[cfg(test)]

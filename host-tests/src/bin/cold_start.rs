@@ -112,15 +112,21 @@ fn every_step(args: &Args) {
             counts: CountModel::SharedStep(step),
             frames: args.frames,
         };
-        let cells: Vec<String> = [false, true]
-            .into_iter()
-            .map(|quiet| {
-                let c = cold_start(model, OFFSETS, quiet, Chunking::Bytes);
-                format!("{} of {} | {}", c.worst.0, args.frames, c.false_frames)
-            })
-            .collect();
-        println!("| +{step} | {} |", cells.join(" | "));
+        println!("| +{step} | {} |", quiet_or_not(model));
     }
+}
+
+/// The cells of `model` one byte at a time, without the quiet reported then with it: the worst
+/// start's frames missed, and the false frames of all starts.
+fn quiet_or_not(model: Model) -> String {
+    let cells: Vec<String> = [false, true]
+        .into_iter()
+        .map(|quiet| {
+            let c = cold_start(model, OFFSETS, quiet, Chunking::Bytes);
+            format!("{} of {} | {}", c.worst.0, model.frames, c.false_frames)
+        })
+        .collect();
+    cells.join(" | ")
 }
 
 /// Every count model on payloads written to fool a parser, one byte at a time: the worst
@@ -145,14 +151,7 @@ fn hostile_payloads(args: &Args) {
                 counts,
                 frames: args.frames,
             };
-            let cells: Vec<String> = [false, true]
-                .into_iter()
-                .map(|quiet| {
-                    let c = cold_start(model, OFFSETS, quiet, Chunking::Bytes);
-                    format!("{} of {} | {}", c.worst.0, args.frames, c.false_frames)
-                })
-                .collect();
-            println!("| {payload_name} | {name} | {} |", cells.join(" | "));
+            println!("| {payload_name} | {name} | {} |", quiet_or_not(model));
         }
     }
 }

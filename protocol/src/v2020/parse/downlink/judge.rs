@@ -59,8 +59,6 @@ struct Walk<'a> {
     /// was seen (one counter shared by all streams steps every frame alike); `None` once two
     /// steps differ.
     shared: Option<(u8, u8, u8)>,
-    /// (Exact) a frame of the chain already passed over.
-    skipped: bool,
     /// What the frames passed over (their count a header's second byte) left.
     passed: Passed,
     /// Where the chain's last frame of each stream starts, the candidate's included
@@ -81,6 +79,8 @@ struct Passed {
     /// A frame of the candidate's own stream was a link (not passed over): its count, not the
     /// candidate's, is the one the stream's next frames continue.
     own_linked: bool,
+    /// (Exact) A frame of the chain was passed over (a stream's first).
+    skipped: bool,
 }
 
 impl<'a> Walk<'a> {
@@ -116,7 +116,6 @@ impl<'a> Walk<'a> {
             gap: rule.gap,
             own_step: None,
             shared: frame.seq().map(|seq| (seq, 0, 0)),
-            skipped: false,
             passed: Passed::default(),
             starts,
         }
@@ -166,7 +165,7 @@ impl<'a> Walk<'a> {
             .and_then(|second| stream_of_second(*second))
             .filter(|_| buf.get(pos.wrapping_sub(1)) != Some(&sync));
         match lost_first {
-            Some(stream) if self.rule.chain == Chain::Exact && !self.skipped => {
+            Some(stream) if self.rule.chain == Chain::Exact && !self.passed.skipped => {
                 let next = pos
                     .saturating_sub(1)
                     .saturating_add(Kind::Telemetry(stream).len());
@@ -216,7 +215,7 @@ impl<'a> Walk<'a> {
         };
         if self.rule.chain == Chain::Exact {
             self.exact_link(telemetry, at, end)?;
-            self.skipped = true;
+            self.passed.skipped = true;
         } else if let Some((stream, seq)) = telemetry {
             self.counted_link(stream, seq, at)?;
         }
@@ -241,7 +240,7 @@ impl<'a> Walk<'a> {
             }
             // The next frame damaged (its count byte lost or changed): the frame after it
             // decides.
-            Rel::Far if !self.skipped => {
+            Rel::Far if !self.passed.skipped => {
                 let places = [end.saturating_sub(1), end.saturating_add(1)];
                 Break(self.parser.past_a_damaged_frame(
                     self.buf,
