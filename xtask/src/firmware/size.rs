@@ -122,20 +122,27 @@ pub mod budget {
 /// Builds the probes and the bring-up firmware, prints the table, returns whether every
 /// asserted budget holds.
 pub fn size_table() -> Result<bool, String> {
+    let probes = probe_sizes()?;
+    board_table(&probes)
+}
+
+/// Builds every board's bring-up firmware, prints its table and the protocol's share from
+/// `probes` ([`probe_sizes`]), returns whether every asserted budget holds.
+pub fn board_table(probes: &[Sizes]) -> Result<bool, String> {
     install_targets(&FIRMWARE_TARGETS)?;
-    let probe = probe_sizes()?;
     let mut firmware = Vec::new();
     for b in &BOARDS {
         build_board(b, &[], &[])?;
         firmware.push(sizes(&elf(b, b.bin)?)?);
     }
     let fw_ok = print_firmware(&firmware);
-    let protocol_ok = print_protocol_share(&probe);
+    let protocol_ok = print_protocol_share(probes);
     Ok(fw_ok && protocol_ok)
 }
 
 /// Builds the size probes on the QEMU board and reads their sizes, in [`PROBES`]' order.
-fn probe_sizes() -> Result<Vec<Sizes>, String> {
+pub fn probe_sizes() -> Result<Vec<Sizes>, String> {
+    install_targets(&FIRMWARE_TARGETS)?;
     let board = &BOARDS[0];
     // Probes: no logger, no log, so they measure the protocol and nothing else.
     let mut bins = Vec::new();
