@@ -7,12 +7,13 @@ use std::path::Path;
 use std::process::Command;
 
 /// The fuzz targets, in `host-tests/fuzz`, each with the number of runs `test` gives it (about
-/// 30 s each here).
+/// 30 s each on a 2-core machine: 5 000 runs a second on `downlink`, 1 200 on `spliced`, 7 000
+/// to 16 000 on the others).
 const FUZZ_TARGETS: [(&str, u32); 5] = [
-    ("downlink", 500_000),
-    ("uplink", 500_000),
-    ("roundtrip", 1_000_000),
-    ("spliced", 50_000),
+    ("downlink", 150_000),
+    ("uplink", 250_000),
+    ("roundtrip", 400_000),
+    ("spliced", 40_000),
     ("v1", 500_000),
 ];
 

@@ -18,7 +18,7 @@
 //! | `qemu ELF [--scenario NAME]` | boots a firmware in QEMU against the simulated chassis (the QEMU board's cargo runner) |
 //!
 //! Each task installs what it needs (rustup targets, `qemu-system-arm` through apt when run as
-//! root, defmt-print, the nightly toolchain, cargo-fuzz, cargo-public-api and cargo-hack) before it runs, so
+//! root, defmt-print, the nightly toolchain, cargo-fuzz, cargo-public-api, cargo-hack and cargo-nextest) before it runs, so
 //! a fresh machine with rustup and cargo needs nothing else.
 //!
 //! A module per family of tasks: [`mod@test`], [`package`], [`public_api`], [`python`], [`ros2`], [`mod@bench`]
