@@ -28,8 +28,9 @@ use std::time::{Duration, Instant};
 /// cancellation reads the pending angle) and the firmware detection it may be in.
 const EXIT_BOUND: Duration = Duration::from_secs(3);
 
-/// Runs at once (each a command, a simulated board and a pseudo-terminal or two).
-const PARALLEL: usize = 4;
+/// Runs at once (each a command, a simulated board and a pseudo-terminal or two; a run mostly
+/// waits for its moment: four at a time kept a quarter of a 2-core machine busy).
+const PARALLEL: usize = 8;
 
 /// How long a process may take to reach `main` on a loaded machine: a signal within it may end
 /// the process by itself, before it did anything (then nothing may have been sent; that the
