@@ -46,7 +46,7 @@ pub(crate) fn test() -> Result<(), String> {
         "chassis-host-tests",
         "--features",
         "no-panic-proof",
-        "--example",
+        "--bin",
         "no_panic",
     ])?;
     // Every public item documented, every intra-doc link resolved.

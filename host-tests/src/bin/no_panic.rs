@@ -2,11 +2,11 @@
 //!
 //! Each function below is marked `#[no_panic]`: if the compiler cannot prove that it (with
 //! everything it calls, after inlining) never panics, the link fails. `cargo xtask test` builds
-//! this example with the `no-panic` profile (release, fat LTO, one codegen unit: everything must
+//! this binary with the `no-panic` profile (release, fat LTO, one codegen unit: everything must
 //! be inlined for the proof), so a panic path reachable from untrusted bytes breaks CI:
 //!
 //! ```text
-//! cargo build --profile no-panic -p chassis-host-tests --features no-panic-proof --example no_panic
+//! cargo build --profile no-panic -p chassis-host-tests --features no-panic-proof --bin no_panic
 //! ```
 
 use chassis_protocol::v1::{self, Parser as _};
