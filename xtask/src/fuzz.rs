@@ -1,13 +1,14 @@
 //! The fuzz targets (`host-tests/fuzz`): `cargo xtask fuzz [SECONDS]` explores, `test` runs each
-//! a fixed number of times from a fixed seed.
+//! a fixed number of times from a fixed seed. Built once, then run as many side by side as the
+//! machine has cores, each one's output in `target/fuzz-logs/<target>.log`.
 
 use crate::cmd::{check, host_tests, workspace_root};
 use crate::tools::{install_cargo_tool, install_nightly};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The fuzz targets, in `host-tests/fuzz`, each with the number of runs `test` gives it (about
-/// 30 s each on a 2-core machine: 5 000 runs a second on `downlink`, 1 200 on `spliced`, 7 000
+/// 30 s each on one core of a 2-core machine: 5 000 runs a second on `downlink`, 1 200 on `spliced`, 7 000
 /// to 16 000 on the others).
 const FUZZ_TARGETS: [(&str, u32); 5] = [
     ("downlink", 150_000),
@@ -75,28 +76,135 @@ pub(crate) fn fuzz(run: FuzzRun) -> Result<(), String> {
     let corpus_arg = corpus.to_string_lossy().into_owned();
     host_tests("--bin", "fuzz-seeds", &[&corpus_arg])?;
     add_regressions(&fuzz_dir.join("regressions"), &corpus)?;
-    for (target, runs) in FUZZ_TARGETS {
-        let target_corpus = corpus.join(target).to_string_lossy().into_owned();
-        let limits = match run {
-            FuzzRun::Repeatable => vec![
-                format!("-seed={CI_FUZZ_SEED}"),
-                format!("-runs={runs}"),
-                "-max_total_time=120".to_string(),
-            ],
-            FuzzRun::Explore(seconds) => vec![format!("-max_total_time={seconds}")],
-        };
-        let mut args = vec!["+nightly", "fuzz", "run", target, &target_corpus, "--"];
-        args.extend(limits.iter().map(String::as_str));
-        eprintln!("$ cargo {}", args.join(" "));
-        check(
-            Command::new("cargo").args(&args).current_dir(&fuzz_dir),
-            "cargo fuzz",
-            |status| {
-                format!(
-                    "fuzz target {target} failed ({status}): see host-tests/fuzz/artifacts/{target}"
-                )
-            },
-        )?;
+    // Every target built once, then run side by side (libFuzzer keeps one core busy): the
+    // binaries themselves, as `cargo fuzz run` would start them.
+    let target_dir = fuzz_dir.join("target");
+    let target_dir_arg = target_dir.to_string_lossy().into_owned();
+    let build = ["+nightly", "fuzz", "build", "--target-dir", &target_dir_arg];
+    eprintln!("$ cargo {}", build.join(" "));
+    check(
+        Command::new("cargo").args(build).current_dir(&fuzz_dir),
+        "cargo fuzz",
+        |status| format!("cargo fuzz build failed ({status})"),
+    )?;
+    let bins = target_dir.join(host_triple()?).join("release");
+    let logs = root.join("target").join("fuzz-logs");
+    std::fs::create_dir_all(&logs).map_err(|e| format!("cannot create {}: {e}", logs.display()))?;
+    let jobs: Vec<FuzzJob> = FUZZ_TARGETS
+        .iter()
+        .map(|&(target, runs)| {
+            let artifacts = fuzz_dir.join("artifacts").join(target);
+            let mut args = vec![
+                format!("-artifact_prefix={}/", artifacts.display()),
+                corpus.join(target).to_string_lossy().into_owned(),
+            ];
+            match run {
+                FuzzRun::Repeatable => args.extend([
+                    format!("-seed={CI_FUZZ_SEED}"),
+                    format!("-runs={runs}"),
+                    "-max_total_time=120".to_string(),
+                ]),
+                FuzzRun::Explore(seconds) => args.push(format!("-max_total_time={seconds}")),
+            }
+            FuzzJob {
+                target,
+                program: bins.join(target),
+                args,
+                artifacts,
+                log: logs.join(format!("{target}.log")),
+            }
+        })
+        .collect();
+    let side_by_side = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+    run_jobs(&jobs, side_by_side)
+}
+
+/// One fuzz target's run.
+struct FuzzJob {
+    target: &'static str,
+    program: PathBuf,
+    args: Vec<String>,
+    artifacts: PathBuf,
+    log: PathBuf,
+}
+
+impl FuzzJob {
+    /// Runs it to the end, its output into its log; what went wrong, if anything.
+    fn run(&self) -> Result<(), String> {
+        if let Err(e) = std::fs::create_dir_all(&self.artifacts) {
+            return Err(format!("cannot create {}: {e}", self.artifacts.display()));
+        }
+        let log = std::fs::File::create(&self.log)
+            .map_err(|e| format!("cannot create {}: {e}", self.log.display()))?;
+        let err = log
+            .try_clone()
+            .map_err(|e| format!("cannot write {}: {e}", self.log.display()))?;
+        eprintln!("$ {} {}", self.program.display(), self.args.join(" "));
+        let status = Command::new(&self.program)
+            .args(&self.args)
+            .stdout(log)
+            .stderr(err)
+            .status()
+            .map_err(|e| format!("could not start {}: {e}", self.program.display()))?;
+        let text = std::fs::read_to_string(&self.log).unwrap_or_default();
+        if status.success() {
+            let done = text
+                .lines()
+                .rev()
+                .find(|l| l.starts_with("Done "))
+                .unwrap_or("done");
+            eprintln!("fuzz target {}: {done}", self.target);
+            Ok(())
+        } else {
+            let lines: Vec<&str> = text.lines().collect();
+            let tail = lines.get(lines.len().saturating_sub(40)..).unwrap_or(&[]);
+            eprintln!("{}", tail.join("\n"));
+            Err(format!(
+                "fuzz target {} failed ({status}): see {} and {}",
+                self.target,
+                self.artifacts.display(),
+                self.log.display()
+            ))
+        }
     }
-    Ok(())
+}
+
+/// Runs `jobs`, `side_by_side` at a time, each to its end; the first failure, if any.
+fn run_jobs(jobs: &[FuzzJob], side_by_side: usize) -> Result<(), String> {
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let failures = std::sync::Mutex::new(Vec::new());
+    std::thread::scope(|scope| {
+        for _ in 0..side_by_side.clamp(1, jobs.len().max(1)) {
+            scope.spawn(|| {
+                while let Some(job) =
+                    jobs.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
+                {
+                    if let Err(e) = job.run() {
+                        if let Ok(mut failures) = failures.lock() {
+                            failures.push(e);
+                        }
+                    }
+                }
+            });
+        }
+    });
+    let failures = failures.into_inner().unwrap_or_default();
+    if failures.is_empty() {
+        Ok(())
+    } else {
+        Err(failures.join("; "))
+    }
+}
+
+/// The host's target triple, where `cargo fuzz build` puts the binaries.
+fn host_triple() -> Result<String, String> {
+    let output = Command::new("rustc")
+        .args(["+nightly", "-vV"])
+        .output()
+        .map_err(|e| format!("could not start rustc: {e}"))?;
+    String::from_utf8_lossy(&output.stdout)
+        .lines()
+        .find_map(|l| l.strip_prefix("host: "))
+        .map(str::to_string)
+        .ok_or_else(|| "rustc -vV names no host".to_string())
 }
