@@ -92,28 +92,7 @@ pub(crate) fn fuzz(run: FuzzRun) -> Result<(), String> {
     std::fs::create_dir_all(&logs).map_err(|e| format!("cannot create {}: {e}", logs.display()))?;
     let jobs: Vec<FuzzJob> = FUZZ_TARGETS
         .iter()
-        .map(|&(target, runs)| {
-            let artifacts = fuzz_dir.join("artifacts").join(target);
-            let mut args = vec![
-                format!("-artifact_prefix={}/", artifacts.display()),
-                corpus.join(target).to_string_lossy().into_owned(),
-            ];
-            match run {
-                FuzzRun::Repeatable => args.extend([
-                    format!("-seed={CI_FUZZ_SEED}"),
-                    format!("-runs={runs}"),
-                    "-max_total_time=120".to_string(),
-                ]),
-                FuzzRun::Explore(seconds) => args.push(format!("-max_total_time={seconds}")),
-            }
-            FuzzJob {
-                target,
-                program: bins.join(target),
-                args,
-                artifacts,
-                log: logs.join(format!("{target}.log")),
-            }
-        })
+        .map(|&(target, runs)| FuzzJob::new(target, runs, &run, &fuzz_dir, &bins, &corpus, &logs))
         .collect();
     let side_by_side = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
     run_jobs(&jobs, side_by_side)
@@ -129,6 +108,39 @@ struct FuzzJob {
 }
 
 impl FuzzJob {
+    /// `target`'s run: its binary in `bins`, its corpus in `corpus`, its log in `logs`, `runs`
+    /// runs if the run is repeatable.
+    fn new(
+        target: &'static str,
+        runs: u32,
+        run: &FuzzRun,
+        fuzz_dir: &Path,
+        bins: &Path,
+        corpus: &Path,
+        logs: &Path,
+    ) -> Self {
+        let artifacts = fuzz_dir.join("artifacts").join(target);
+        let mut args = vec![
+            format!("-artifact_prefix={}/", artifacts.display()),
+            corpus.join(target).to_string_lossy().into_owned(),
+        ];
+        match run {
+            FuzzRun::Repeatable => args.extend([
+                format!("-seed={CI_FUZZ_SEED}"),
+                format!("-runs={runs}"),
+                "-max_total_time=120".to_string(),
+            ]),
+            FuzzRun::Explore(seconds) => args.push(format!("-max_total_time={seconds}")),
+        }
+        FuzzJob {
+            target,
+            program: bins.join(target),
+            args,
+            artifacts,
+            log: logs.join(format!("{target}.log")),
+        }
+    }
+
     /// Runs it to the end, its output into its log; what went wrong, if anything.
     fn run(&self) -> Result<(), String> {
         if let Err(e) = std::fs::create_dir_all(&self.artifacts) {
