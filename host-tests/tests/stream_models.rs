@@ -170,6 +170,33 @@ fn a_cold_start_on_payloads_written_to_fool_it_emits_no_false_frame() {
 }
 
 #[test]
+fn a_cold_start_on_lookalikes_whose_shared_counter_passes_their_header_bytes_emits_no_false_frame()
+{
+    // Payloads whose every value reads -6..-4, under one counter shared by all streams stepping
+    // by 2 or 3: on these streams the counter passes `FA`..`FC`, so an IMU lookalike hiding in
+    // the payloads ends on a byte equal to the line's count, and the real frames after it are
+    // in step from there (each was a start with false frames: seed 7051, +3, starts 1 to 23;
+    // 7215, +3, 83 to 120; 2141, +2, 143). Found while hunting, with no count to go by, a
+    // candidate whose count byte is a header's second is never taken (row 15).
+    for (seed, step) in [(7051, 3), (7215, 3), (2141, 2)] {
+        let model = Model {
+            seed,
+            payload: Payload::Lookalikes,
+            counts: CountModel::SharedStep(step),
+            frames: 60,
+        };
+        for quiet in [false, true] {
+            let c = cold_start(model, 0..200, quiet, Chunking::Bytes);
+            assert_eq!(
+                (c.starts_false, c.false_frames),
+                (0, 0),
+                "seed {seed}, +{step}, quiet {quiet}"
+            );
+        }
+    }
+}
+
+#[test]
 #[ignore = "the parser misses 1 or 2 frames at some cold starts under every count model: the first whole frame, or a first burst that the quiet line ends, before any count has been seen to continue (a frame of a stream not yet seen, or a reply nobody awaits, found while hunting, can be any payload's tail)"]
 fn a_cold_start_is_exact_from_the_first_whole_frame_under_every_shared_counter() {
     for step in 1..=7 {

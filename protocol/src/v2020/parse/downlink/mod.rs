@@ -13,7 +13,7 @@
 //! | # | where it starts | what it is | taken |
 //! |---|---|---|---|
 //! | 14 | Hunting | telemetry whose bytes hold a real frame it cannot be | never |
-//! | 15 | any | a far count that is a header's second byte (a cut frame) | never; Locked, Tentative: the quiet line right after |
+//! | 15 | any | a far count (Hunting: also the stream's first) that is a header's second byte (a cut frame) | never; Locked, Tentative: the quiet line right after |
 //! | 1 | a boundary | telemetry, count continues | on its last byte |
 //! | 4 | Locked, Resynced | telemetry, count near, or the stream's first | with a header after it |
 //! | 5 | Locked | telemetry, count far | a chain, re-basing (or the quiet line) |

@@ -173,6 +173,10 @@ pub const fn decide(start: Start, f: Facts) -> (u8, Need) {
         //     cut frame would have the rest of the next frame after it, not the quiet).
         Seen::Telemetry(Far) if f.cut && matches!(start, Locked | Tentative) => (15, Quiet),
         Seen::Telemetry(Far) if f.cut => (15, Never),
+        //     Hunting, with no count to go by, the same: nothing tells that byte from a
+        //     payload's `FF FA`..`FF FC` (a lookalike ending there while the line's counter
+        //     passes that value has the real frames after it in step from it).
+        Seen::Telemetry(Unknown) if f.cut && hunting => (15, Never),
         // 1. On a boundary, the count continues: taken on its last byte.
         Seen::Telemetry(Continues) if !hunting => (1, Now),
         // 4. On a certain boundary, frames lost or the stream's first: a header after it.
@@ -389,5 +393,15 @@ mod tests {
         for start in [Tentative, Locked] {
             assert_eq!(decide(start, cut), (15, Need::Quiet));
         }
+        // Hunting, a stream's first frame whose count byte is a header's second: never; on a
+        // certain boundary or after a quiet line, as any stream's first.
+        let first = Facts {
+            cut: true,
+            ..telemetry(Unknown)
+        };
+        assert_eq!(decide(Hunting, first), (15, Need::Never));
+        assert_eq!(row(Resynced, first), 4);
+        assert_eq!(row(Locked, first), 4);
+        assert_eq!(row(Tentative, first), 7);
     }
 }
