@@ -58,60 +58,29 @@ const PROBES: [&str; 8] = [
     "size_v1_parsers",
 ];
 
-/// The budgets of the firmware issue, in bytes.
+/// The firmware's size budgets, in bytes.
 pub mod budget {
-    /// The whole QEMU bring-up firmware's flash. 32 KiB while it ran the 2020 bring-up alone
-    /// (30 872 B); raised to 46 KiB when it learnt to detect the generation and run the v1.0.0
-    /// bring-up too (45 476 B: detection, the v1.0.0 driver and parser, the v1.0.0 checks);
-    /// raised to 47 KiB (46 128 → 47 080 B) when the 2020 parser learnt to judge at the same
-    /// bytes however they are fed (`push`, `push_slice`, `poll`, `expect_reply`): the bytes
-    /// pushed while a chain's frames are still coming out wait behind them.
+    /// The whole QEMU bring-up firmware's flash: both generations' bring-up, generation
+    /// detection, both drivers and parsers (47 236 B).
     pub const FIRMWARE_FLASH: u64 = 47 * 1024;
     /// The whole QEMU bring-up firmware's RAM (static here; the stack peak is checked by the
     /// end-to-end test, which reads it from the firmware's log).
     pub const FIRMWARE_RAM: u64 = 8 * 1024;
-    /// The goal for parsers + builders at opt-level "s" on thumbv7em: **not met** today.
-    pub const PROTOCOL_GOAL: u64 = 4 * 1024;
+    /// The goal for parsers + builders at opt-level "s" on thumbv7em (stretch: 4 KiB): **not
+    /// met** today.
+    pub const PROTOCOL_GOAL: u64 = 6 * 1024;
     /// What parsers + builders may not grow past: a regression guard until the goal above is
-    /// met. Set at 10 KiB (measured 9 348 B); raised to 11 KiB when the parser learnt to take
-    /// a reply nobody awaits past a damaged frame (10 776 B): recall was below its goal; raised
-    /// to 12 KiB when row 14 learnt damaged inner frames and the tail of a frame that lost its
-    /// first byte (11 600 B, about 440 B of judgement): false frames were above their goal.
-    /// (11 984 B after the next stop's rules against false frames and for recall; 12 124 B,
-    /// 164 B left, once every row of the sweep met the false-frame goal.) The acceptance table
-    /// and one window for both parsers brought it to 12 096 B; raised to 13 KiB when the
-    /// parser learnt to follow one counter shared by all streams, at any step, from a cold start
-    /// (444 B: the frames in step whatever their streams, a whole frame in the candidate's
-    /// tail) and took row 11 without the general judgement (308 B, 2.4 instructions a byte
-    /// less on the Cortex-M4): 12 848 B; 13 256 B once row 1 and a frame's header took short
-    /// ways of their own (408 B for 3.2 instructions a byte less on the Cortex-M4). Raised to
-    /// 13.5 KiB for what an outside attack found (152 B: `poll` and the slice path judge at
-    /// the bytes `push` judges at; an awaited reply that may be a frame's tail is not taken):
-    /// 13 408 B; 13 496 B with the frames-in-step rule across streams on again. Raised to
-    /// 14 KiB when the parser learnt to judge at the same bytes however they are fed and
-    /// polled, `expect_reply` calls between included (528 B: the bytes pushed while a chain's
-    /// frames are still coming out wait behind them, an `expect_reply` made then waits until
-    /// those frames are out, and the slice path stores and judges where `push` does): 14 024 B;
-    /// raised to 14.5 KiB when the bytes behind a chain's frames learnt to keep the state the
-    /// frame before them left (the fuzz target found them left unjudged): 14 360 B; 14 776 B
-    /// with what two outside attacks found (frames in step vouch after a quiet line and for a
-    /// count stepping down; a step seen twice that divides a learnt one; row 15's quiet line; a
-    /// frame passed over that continues its stream exactly). Lowered to 12.75 KiB when the
-    /// parser and the builders stopped calling `memcpy` (its 742 B no longer linked in), the
-    /// builders wrote each field at a constant offset and the window's bytes were read out of
-    /// line but on the per-frame paths: 12 732 B (12 772 B with the frame after an unawaited
-    /// reply judged without the machinery for bytes behind it; 12 808 B with a chain's next
-    /// header only waited for).
+    /// met, a little above what they measure (12 988 B). Most of it is the 2020 board → master
+    /// parser's general judgement, which the noise sweep's and the cold start's figures rest
+    /// on; the short ways that take a frame without it cost flash for instructions
+    /// (`docs/performance.md`).
     pub const PROTOCOL_CEILING: u64 = 12 * 1024 + 768;
     /// Hardware boards' budgets, by directory: (flash, static RAM), a little above what each
     /// measured when it was added (a regression guard; the ESP32-C3's RAM counts the 3 KiB of
     /// code esp-hal runs from its SRAM).
     pub const BOARDS: [(&str, u64, u64); 3] = [
         ("esp32c3", 70 * 1024, 5 * 1024),
-        // (Raised from 48 KiB with the parser's rules the outside attacks asked for: 48 900 →
-        // 49 340 B; back to 48 KiB with the parser's and builders' trims: 48 896 B.)
         ("nrf52840", 48 * 1024, 4 * 1024),
-        // (Raised from 50 KiB with the parsers' ceiling above: 50 916 → 51 544 B.)
         ("stm32-dma", 51 * 1024, 4 * 1024),
     ];
     /// What the v1.0.0 board → master parser may not grow past (`size_v1_downlink` − board): a
@@ -248,7 +217,7 @@ fn print_ceilings(protocol: u64, v1_downlink: u64) -> bool {
     let goal = protocol <= budget::PROTOCOL_GOAL;
     let protocol_ok = protocol <= budget::PROTOCOL_CEILING;
     println!(
-        "\nparsers + builders: {protocol} B against the 4 KiB goal: {}; ceiling {} B (regression guard): {}",
+        "\nparsers + builders: {protocol} B against the 6 KiB goal (stretch 4 KiB): {}; ceiling {} B (regression guard): {}",
         met(goal),
         budget::PROTOCOL_CEILING,
         held(protocol_ok)
