@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The fuzz targets, in `host-tests/fuzz`, each with the number of runs `test` gives it (about
-/// 30 s each on one core of a 2-core machine: 5 000 runs a second on `downlink`, 1 200 on `spliced`, 7 000
-/// to 16 000 on the others).
+/// 30 s each on one core of a 2-core machine: 5 000 runs a second on `downlink`, 1 200 on
+/// `spliced`, 7 000 to 16 000 on the others).
 const FUZZ_TARGETS: [(&str, u32); 5] = [
     ("downlink", 150_000),
     ("uplink", 250_000),
@@ -181,7 +181,7 @@ impl FuzzJob {
     }
 }
 
-/// Runs `jobs`, `side_by_side` at a time, each to its end; the first failure, if any.
+/// Runs `jobs`, `side_by_side` at a time, each to its end; every failure, if any, in one error.
 fn run_jobs(jobs: &[FuzzJob], side_by_side: usize) -> Result<(), String> {
     let next = std::sync::atomic::AtomicUsize::new(0);
     let failures = std::sync::Mutex::new(Vec::new());
